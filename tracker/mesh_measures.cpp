@@ -1,0 +1,130 @@
+#include "tracker/mesh_measures.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace meniscus::tracker {
+
+namespace {
+
+constexpr double RADIANS_TO_DEGREES = 180.0 / M_PI;
+
+/// Six times the signed volume of the tetrahedron (origin, a, b, c), about a reference point to
+/// keep round-off small for meshes far from the origin.
+double tet6(const Vec3& ref, const Vec3& a, const Vec3& b, const Vec3& c) {
+    return (a - ref).dot((b - ref).cross(c - ref));
+}
+
+Vec3 reference_point(const SurfaceMesh& mesh) {
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        if (mesh.vertex_alive(vi)) return mesh.position(vi);
+    return Vec3::Zero();
+}
+
+}  // namespace
+
+double enclosed_volume(const SurfaceMesh& mesh) {
+    const Vec3 ref = reference_point(mesh);
+    double six_v = 0.0;
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti)) continue;
+        const Triangle& t = mesh.triangle(ti);
+        six_v += tet6(ref, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+    }
+    return six_v / 6.0;
+}
+
+double surface_area(const SurfaceMesh& mesh) {
+    double twice = 0.0;
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti)) continue;
+        const Triangle& t = mesh.triangle(ti);
+        const Vec3& a = mesh.position(t[0]);
+        twice += (mesh.position(t[1]) - a).cross(mesh.position(t[2]) - a).norm();
+    }
+    return twice / 2.0;
+}
+
+EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh) {
+    EdgeLengthStats s;
+    s.min = std::numeric_limits<double>::infinity();
+    double sum = 0.0;
+    for (int ei = 0; ei < mesh.num_edges(); ++ei) {
+        if (!mesh.edge_alive(ei)) continue;
+        const Edge& e = mesh.edge(ei);
+        const double l = (mesh.position(e[1]) - mesh.position(e[0])).norm();
+        s.min = std::min(s.min, l);
+        s.max = std::max(s.max, l);
+        sum += l;
+        ++s.count;
+    }
+    if (s.count == 0) return EdgeLengthStats{};
+    s.mean = sum / s.count;
+    return s;
+}
+
+AngleStats angle_stats(const SurfaceMesh& mesh) {
+    AngleStats s{std::numeric_limits<double>::infinity(), 0.0};
+    bool any = false;
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti)) continue;
+        const Triangle& t = mesh.triangle(ti);
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 u = mesh.position(t[(k + 1) % 3]) - mesh.position(t[k]);
+            const Vec3 v = mesh.position(t[(k + 2) % 3]) - mesh.position(t[k]);
+            const double angle = std::atan2(u.cross(v).norm(), u.dot(v)) * RADIANS_TO_DEGREES;
+            s.min_degrees = std::min(s.min_degrees, angle);
+            s.max_degrees = std::max(s.max_degrees, angle);
+            any = true;
+        }
+    }
+    return any ? s : AngleStats{};
+}
+
+Components triangle_components(const SurfaceMesh& mesh) {
+    Components c;
+    c.triangle_component.assign(static_cast<size_t>(mesh.num_triangles()), INVALID_INDEX);
+    std::vector<int> stack;
+    for (int seed = 0; seed < mesh.num_triangles(); ++seed) {
+        if (!mesh.triangle_alive(seed) || c.triangle_component[static_cast<size_t>(seed)] >= 0)
+            continue;
+        const int id = c.count++;
+        c.triangle_component[static_cast<size_t>(seed)] = id;
+        stack.push_back(seed);
+        while (!stack.empty()) {
+            const int ti = stack.back();
+            stack.pop_back();
+            for (int ei : mesh.triangle_edges(ti)) {
+                for (int tj : mesh.edge_triangles(ei)) {
+                    if (c.triangle_component[static_cast<size_t>(tj)] >= 0) continue;
+                    c.triangle_component[static_cast<size_t>(tj)] = id;
+                    stack.push_back(tj);
+                }
+            }
+        }
+    }
+    return c;
+}
+
+std::vector<double> component_volumes(const SurfaceMesh& mesh, const Components& components) {
+    std::vector<double> six_v(static_cast<size_t>(components.count), 0.0);
+    const Vec3 ref = reference_point(mesh);
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti)) continue;
+        const Triangle& t = mesh.triangle(ti);
+        six_v[static_cast<size_t>(components.triangle_component[static_cast<size_t>(ti)])] +=
+            tet6(ref, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+    }
+    for (double& v : six_v) v /= 6.0;
+    return six_v;
+}
+
+int euler_characteristic(const SurfaceMesh& mesh) {
+    int used_vertices = 0;
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        used_vertices += mesh.vertex_alive(vi) && !mesh.vertex_triangles(vi).empty() ? 1 : 0;
+    return used_vertices - mesh.count_live_edges() + mesh.count_live_triangles();
+}
+
+}  // namespace meniscus::tracker

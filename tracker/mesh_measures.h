@@ -1,0 +1,44 @@
+#pragma once
+/// \file Geometric and topological measures of a SurfaceMesh: volume, area, edge lengths,
+/// triangle angles, connected components and Euler characteristic. Dead elements are skipped.
+
+#include "tracker/mesh.h"
+
+#include <vector>
+
+namespace meniscus::tracker {
+
+/// Signed volume enclosed by the live triangles (divergence theorem; positive when normals
+/// point outward of the enclosed region). Meaningful for closed surfaces; units: length³.
+double enclosed_volume(const SurfaceMesh& mesh);
+/// Total area of live triangles (length²).
+double surface_area(const SurfaceMesh& mesh);
+
+/// Edge length statistics over live edges (length units).
+struct EdgeLengthStats {
+    int count = 0;
+    double min = 0.0, max = 0.0, mean = 0.0;
+};
+EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh);
+
+/// Triangle angle statistics over live triangles (degrees).
+struct AngleStats {
+    double min_degrees = 0.0, max_degrees = 0.0;
+};
+AngleStats angle_stats(const SurfaceMesh& mesh);
+
+/// Connected components of live triangles (triangles sharing an edge are connected).
+struct Components {
+    int count = 0;
+    /// Component id of each triangle slot (INVALID_INDEX for dead triangles).
+    std::vector<int> triangle_component;
+};
+Components triangle_components(const SurfaceMesh& mesh);
+
+/// Signed enclosed volume of each component in `components` (indexed by component id).
+std::vector<double> component_volumes(const SurfaceMesh& mesh, const Components& components);
+
+/// V − E + F over live elements (2 per sphere-like closed component, 0 per torus).
+int euler_characteristic(const SurfaceMesh& mesh);
+
+}  // namespace meniscus::tracker
