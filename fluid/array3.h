@@ -1,0 +1,77 @@
+#pragma once
+/// \file Dense 3D array with contiguous storage, the storage of every grid field in fluid/.
+///
+/// Layout: element (i, j, k) lives at flat index i + ni·(j + nj·k), so i varies fastest. There are
+/// no per-element virtual calls and no bounds checks in Release (MENISCUS_ASSERT when enabled).
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+#include "common/assert.h"
+
+namespace meniscus::fluid {
+
+/// Dense ni × nj × nk array of T, i fastest (see file comment).
+template <class T>
+class Array3 {
+public:
+    Array3() = default;
+    /// Creates an ni × nj × nk array filled with `value`. Sizes must be ≥ 0.
+    Array3(int ni, int nj, int nk, T value = T()) { resize(ni, nj, nk, value); }
+
+    /// Resizes to ni × nj × nk and fills every element with `value`.
+    void resize(int ni, int nj, int nk, T value = T()) {
+        MENISCUS_ASSERT(ni >= 0 && nj >= 0 && nk >= 0, "Array3 sizes must be non-negative");
+        m_ni = ni;
+        m_nj = nj;
+        m_nk = nk;
+        m_data.assign(static_cast<std::size_t>(ni) * nj * nk, value);
+    }
+
+    int ni() const { return m_ni; }
+    int nj() const { return m_nj; }
+    int nk() const { return m_nk; }
+    /// Number of elements ni·nj·nk.
+    std::size_t size() const { return m_data.size(); }
+
+    /// Flat index of (i, j, k): i + ni·(j + nj·k).
+    std::size_t index(int i, int j, int k) const {
+        return static_cast<std::size_t>(i) +
+               static_cast<std::size_t>(m_ni) *
+                   (static_cast<std::size_t>(j) + static_cast<std::size_t>(m_nj) * k);
+    }
+
+    /// True when (i, j, k) is a valid element.
+    bool contains(int i, int j, int k) const {
+        return i >= 0 && j >= 0 && k >= 0 && i < m_ni && j < m_nj && k < m_nk;
+    }
+
+    T& operator()(int i, int j, int k) {
+        MENISCUS_ASSERT(contains(i, j, k), "Array3 index out of range");
+        return m_data[index(i, j, k)];
+    }
+    const T& operator()(int i, int j, int k) const {
+        MENISCUS_ASSERT(contains(i, j, k), "Array3 index out of range");
+        return m_data[index(i, j, k)];
+    }
+
+    T& operator[](std::size_t flat) { return m_data[flat]; }
+    const T& operator[](std::size_t flat) const { return m_data[flat]; }
+
+    /// Sets every element to `value`.
+    void fill(T value) { std::fill(m_data.begin(), m_data.end(), value); }
+
+    T* data() { return m_data.data(); }
+    const T* data() const { return m_data.data(); }
+    std::vector<T>& storage() { return m_data; }
+    const std::vector<T>& storage() const { return m_data; }
+
+private:
+    int m_ni = 0;
+    int m_nj = 0;
+    int m_nk = 0;
+    std::vector<T> m_data;
+};
+
+}  // namespace meniscus::fluid

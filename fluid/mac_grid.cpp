@@ -1,0 +1,202 @@
+#include "fluid/mac_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace meniscus::fluid {
+
+namespace {
+
+constexpr double HALF = 0.5;
+
+/// Clamps a lattice coordinate onto [0, n−1] and splits it into a base index and a fraction in
+/// [0, 1]; the base index is at most n−2 so that base+1 is valid whenever n ≥ 2.
+void split_coordinate(double s, int n, int& base, double& fraction) {
+    if (n <= 1) {
+        base = 0;
+        fraction = 0.0;
+        return;
+    }
+    s = std::clamp(s, 0.0, static_cast<double>(n - 1));
+    base = std::min(static_cast<int>(std::floor(s)), n - 2);
+    fraction = s - base;
+}
+
+void check_wall(WallType type, const char* name) {
+    if (type != WallType::free_slip && type != WallType::no_slip) {
+        throw std::invalid_argument(std::string("WallOptions.") + name +
+                                    ": unknown wall type (use free_slip or no_slip)");
+    }
+}
+
+}  // namespace
+
+WallType WallOptions::at(int axis, int side) const {
+    if (side != 0 && side != 1) {
+        throw std::invalid_argument("WallOptions::at: side must be 0 (min) or 1 (max)");
+    }
+    switch (axis) {
+        case 0:
+            return side == 0 ? x_min : x_max;
+        case 1:
+            return side == 0 ? y_min : y_max;
+        case 2:
+            return side == 0 ? z_min : z_max;
+        default:
+            throw std::invalid_argument("WallOptions::at: axis must be 0, 1 or 2");
+    }
+}
+
+WallOptions WallOptions::all(WallType type) {
+    WallOptions walls;
+    walls.x_min = walls.x_max = walls.y_min = walls.y_max = walls.z_min = walls.z_max = type;
+    return walls;
+}
+
+void WallOptions::validate() const {
+    check_wall(x_min, "x_min");
+    check_wall(x_max, "x_max");
+    check_wall(y_min, "y_min");
+    check_wall(y_max, "y_max");
+    check_wall(z_min, "z_min");
+    check_wall(z_max, "z_max");
+}
+
+Eigen::Vector3d field_offset(FieldLocation location) {
+    switch (location) {
+        case FieldLocation::x_face:
+            return {0.0, HALF, HALF};
+        case FieldLocation::y_face:
+            return {HALF, 0.0, HALF};
+        case FieldLocation::z_face:
+            return {HALF, HALF, 0.0};
+        case FieldLocation::cell_centre:
+            return {HALF, HALF, HALF};
+    }
+    return {HALF, HALF, HALF};
+}
+
+FieldLocation face_location(int axis) {
+    switch (axis) {
+        case 0:
+            return FieldLocation::x_face;
+        case 1:
+            return FieldLocation::y_face;
+        case 2:
+            return FieldLocation::z_face;
+        default:
+            throw std::invalid_argument("face_location: axis must be 0, 1 or 2");
+    }
+}
+
+TrilinearSample sample_trilinear(const Array3<double>& field, FieldLocation location,
+                                 const Eigen::Vector3d& grid_position) {
+    const Eigen::Vector3d s = grid_position - field_offset(location);
+    int i0, j0, k0;
+    double fx, fy, fz;
+    split_coordinate(s.x(), field.ni(), i0, fx);
+    split_coordinate(s.y(), field.nj(), j0, fy);
+    split_coordinate(s.z(), field.nk(), k0, fz);
+    const int di = field.ni() > 1 ? 1 : 0;
+    const std::size_t dj = field.nj() > 1 ? static_cast<std::size_t>(field.ni()) : 0;
+    const std::size_t dk = field.nk() > 1 ? static_cast<std::size_t>(field.ni()) * field.nj() : 0;
+    const std::size_t base = field.index(i0, j0, k0);
+    const double* f = field.data();
+    const double c000 = f[base], c100 = f[base + di];
+    const double c010 = f[base + dj], c110 = f[base + dj + di];
+    const double c001 = f[base + dk], c101 = f[base + dk + di];
+    const double c011 = f[base + dk + dj], c111 = f[base + dk + dj + di];
+    const double c00 = c000 + fx * (c100 - c000);
+    const double c10 = c010 + fx * (c110 - c010);
+    const double c01 = c001 + fx * (c101 - c001);
+    const double c11 = c011 + fx * (c111 - c011);
+    const double c0 = c00 + fy * (c10 - c00);
+    const double c1 = c01 + fy * (c11 - c01);
+    TrilinearSample sample;
+    sample.value = c0 + fz * (c1 - c0);
+    sample.min = std::min({c000, c100, c010, c110, c001, c101, c011, c111});
+    sample.max = std::max({c000, c100, c010, c110, c001, c101, c011, c111});
+    return sample;
+}
+
+MacGrid::MacGrid(int nx, int ny, int nz, double dx, const Eigen::Vector3d& origin)
+    : m_nx(nx), m_ny(ny), m_nz(nz), m_dx(dx), m_origin(origin) {
+    if (nx < 1 || ny < 1 || nz < 1) {
+        throw std::invalid_argument("MacGrid: nx, ny and nz must be at least 1");
+    }
+    if (!(dx > 0.0) || !std::isfinite(dx)) {
+        throw std::invalid_argument("MacGrid: dx must be a positive, finite length in metres");
+    }
+    if (!origin.allFinite()) {
+        throw std::invalid_argument("MacGrid: origin must be finite");
+    }
+    m_velocity[0].resize(nx + 1, ny, nz, 0.0);
+    m_velocity[1].resize(nx, ny + 1, nz, 0.0);
+    m_velocity[2].resize(nx, ny, nz + 1, 0.0);
+}
+
+Eigen::Vector3d MacGrid::cell_centre(int i, int j, int k) const {
+    return m_origin + m_dx * Eigen::Vector3d(i + HALF, j + HALF, k + HALF);
+}
+
+Eigen::Vector3d MacGrid::face_centre(int axis, int i, int j, int k) const {
+    return m_origin + m_dx * (Eigen::Vector3d(i, j, k) + field_offset(face_location(axis)));
+}
+
+double MacGrid::sample_component(int axis, const Eigen::Vector3d& x) const {
+    return sample_trilinear(m_velocity[axis], face_location(axis), to_grid(x)).value;
+}
+
+Eigen::Vector3d MacGrid::sample_velocity(const Eigen::Vector3d& x) const {
+    const Eigen::Vector3d g = to_grid(x);
+    return {sample_trilinear(m_velocity[0], FieldLocation::x_face, g).value,
+            sample_trilinear(m_velocity[1], FieldLocation::y_face, g).value,
+            sample_trilinear(m_velocity[2], FieldLocation::z_face, g).value};
+}
+
+double MacGrid::divergence(int i, int j, int k) const {
+    const Array3<double>& u_face = m_velocity[0];
+    const Array3<double>& v_face = m_velocity[1];
+    const Array3<double>& w_face = m_velocity[2];
+    return (u_face(i + 1, j, k) - u_face(i, j, k) + v_face(i, j + 1, k) - v_face(i, j, k) +
+            w_face(i, j, k + 1) - w_face(i, j, k)) /
+           m_dx;
+}
+
+Eigen::Vector3d MacGrid::max_abs_velocity() const {
+    Eigen::Vector3d result = Eigen::Vector3d::Zero();
+    for (int axis = 0; axis < 3; ++axis) {
+        for (double value : m_velocity[axis].storage()) {
+            result[axis] = std::max(result[axis], std::abs(value));
+        }
+    }
+    return result;
+}
+
+void MacGrid::zero_wall_normal_velocity() {
+    Array3<double>& u_face = m_velocity[0];
+    Array3<double>& v_face = m_velocity[1];
+    Array3<double>& w_face = m_velocity[2];
+    for (int k = 0; k < m_nz; ++k) {
+        for (int j = 0; j < m_ny; ++j) {
+            u_face(0, j, k) = 0.0;
+            u_face(m_nx, j, k) = 0.0;
+        }
+    }
+    for (int k = 0; k < m_nz; ++k) {
+        for (int i = 0; i < m_nx; ++i) {
+            v_face(i, 0, k) = 0.0;
+            v_face(i, m_ny, k) = 0.0;
+        }
+    }
+    for (int j = 0; j < m_ny; ++j) {
+        for (int i = 0; i < m_nx; ++i) {
+            w_face(i, j, 0) = 0.0;
+            w_face(i, j, m_nz) = 0.0;
+        }
+    }
+}
+
+}  // namespace meniscus::fluid

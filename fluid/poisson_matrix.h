@@ -1,0 +1,50 @@
+#pragma once
+/// \file Compact storage of a symmetric 7-point cell-centred matrix (the pressure Poisson operator
+/// and its multigrid coarsenings) and the parallel vector kernels the Krylov solvers use.
+///
+/// Vectors are std::vector<double> over all ni·nj·nk cells with the Array3 flat index
+/// i + ni·(j + nj·k). A cell is an unknown ("active") iff its diagonal is > 0; inactive rows and
+/// columns are entirely zero and the kernels keep inactive entries of their outputs at zero.
+
+#include <cstddef>
+#include <vector>
+
+#include "fluid/array3.h"
+
+namespace meniscus::fluid {
+
+/// Symmetric 7-point matrix with one diagonal and three off-diagonal arrays (8 bytes each per
+/// cell). off_x(i, j, k) = A(cell(i,j,k), cell(i+1,j,k)) ≤ 0, likewise off_y and off_z; entries
+/// pointing outside the grid are 0.
+struct PoissonMatrix {
+    Array3<double> diag;
+    Array3<double> off_x;
+    Array3<double> off_y;
+    Array3<double> off_z;
+
+    /// Zero matrix on ni × nj × nk cells.
+    void resize(int ni, int nj, int nk);
+    int ni() const { return diag.ni(); }
+    int nj() const { return diag.nj(); }
+    int nk() const { return diag.nk(); }
+    /// Number of cells (rows, including inactive ones).
+    std::size_t size() const { return diag.size(); }
+    /// Number of active cells (diagonal > 0).
+    std::size_t active_count() const;
+
+    /// y = A x (TBB-parallel over z-slabs). x and y have size(); y is resized if needed.
+    void apply(const std::vector<double>& x, std::vector<double>& y) const;
+    /// r = b − A x.
+    void residual(const std::vector<double>& x, const std::vector<double>& b,
+                  std::vector<double>& r) const;
+};
+
+/// Σ a_i b_i, TBB-parallel with a deterministic reduction order.
+double dot(const std::vector<double>& a, const std::vector<double>& b);
+/// y += alpha x (TBB-parallel).
+void axpy(double alpha, const std::vector<double>& x, std::vector<double>& y);
+/// Subtracts the mean over active cells of `matrix` from x on those cells (projection onto the
+/// complement of the constant null space of a pure-Neumann operator).
+void remove_active_mean(const PoissonMatrix& matrix, std::vector<double>& x);
+
+}  // namespace meniscus::fluid

@@ -1,0 +1,248 @@
+#include "fluid/pressure.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "fluid/eigen_reference_solver.h"
+#include "fluid/pcg.h"
+
+namespace meniscus::fluid {
+
+namespace {
+
+/// How one interior face enters the pressure system.
+struct FaceCoupling {
+    enum class Kind {
+        none,          ///< no unknown on either side (free surface: gas–gas)
+        coupled,       ///< both cells unknown: coefficient beta, jump p(hi) − p(lo) = jump
+        dirichlet_lo,  ///< only lo is unknown; p = boundary_pressure at θ·dx from lo's centre
+        dirichlet_hi   ///< only hi is unknown; p = boundary_pressure at θ·dx from hi's centre
+    };
+    Kind kind = Kind::none;
+    double beta = 0.0;               ///< 1/ρ_f, m³/kg (divided by θ for Dirichlet faces)
+    double jump = 0.0;               ///< Pa, coupled faces
+    double boundary_pressure = 0.0;  ///< Pa, Dirichlet faces
+};
+
+FaceCoupling classify_face(double phi_lo, double phi_hi, double kappa, const PhaseOptions& phases,
+                           FluidMode mode, double min_liquid_fraction) {
+    FaceCoupling face;
+    const bool liquid_lo = is_liquid(phi_lo);
+    const bool liquid_hi = is_liquid(phi_hi);
+    if (mode == FluidMode::two_phase) {
+        face.kind = FaceCoupling::Kind::coupled;
+        face.beta = 1.0 / face_density(liquid_fraction(phi_lo, phi_hi), phases, mode);
+        face.jump = face_pressure_jump(phi_lo, phi_hi, phases.sigma, kappa);
+        return face;
+    }
+    if (liquid_lo && liquid_hi) {
+        face.kind = FaceCoupling::Kind::coupled;
+        face.beta = 1.0 / phases.rho_liquid;
+        return face;
+    }
+    if (!liquid_lo && !liquid_hi) {
+        return face;
+    }
+    const double theta = std::max(liquid_fraction(phi_lo, phi_hi), min_liquid_fraction);
+    face.kind = liquid_lo ? FaceCoupling::Kind::dirichlet_lo : FaceCoupling::Kind::dirichlet_hi;
+    face.beta = 1.0 / (phases.rho_liquid * theta);
+    face.boundary_pressure = phases.sigma * kappa;  // gas at zero pressure: p_liquid = σκ
+    return face;
+}
+
+bool is_unknown(double phi, FluidMode mode) {
+    return mode == FluidMode::two_phase || is_liquid(phi);
+}
+
+/// Calls visit(face index (i, j, k), lo cell (li, lj, lk)) for every face of component `axis`
+/// that lies strictly inside the box; the hi cell is (i, j, k).
+template <class Visit>
+void for_each_interior_face(const MacGrid& grid, int axis, Visit&& visit) {
+    const Array3<double>& faces = grid.velocity(axis);
+    const int n_axis = grid.cells(axis);
+    for (int k = 0; k < faces.nk(); ++k) {
+        for (int j = 0; j < faces.nj(); ++j) {
+            for (int i = 0; i < faces.ni(); ++i) {
+                const int along = axis == 0 ? i : (axis == 1 ? j : k);
+                if (along == 0 || along == n_axis) {
+                    continue;
+                }
+                visit(i, j, k, i - (axis == 0 ? 1 : 0), j - (axis == 1 ? 1 : 0),
+                      k - (axis == 2 ? 1 : 0));
+            }
+        }
+    }
+}
+
+Array3<double>& off_diagonal(PoissonMatrix& matrix, int axis) {
+    return axis == 0 ? matrix.off_x : (axis == 1 ? matrix.off_y : matrix.off_z);
+}
+
+}  // namespace
+
+void PressureOptions::validate() const {
+    iteration.validate();
+    if (solver != PressureSolver::mic0_pcg && solver != PressureSolver::multigrid_pcg &&
+        solver != PressureSolver::eigen_ic_cg) {
+        throw std::invalid_argument("PressureOptions.solver: unknown solver");
+    }
+    if (!(min_liquid_fraction > 0.0 && min_liquid_fraction <= 1.0)) {
+        throw std::invalid_argument("PressureOptions.min_liquid_fraction must be in (0, 1]");
+    }
+    mic0.validate();
+    multigrid.validate();
+}
+
+PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& interface,
+                                     const PhaseOptions& phases, FluidMode mode, double dt,
+                                     const PressureOptions& options) {
+    interface.validate(grid);
+    if (!(dt > 0.0)) {
+        throw std::invalid_argument("build_pressure_system: dt must be positive (s)");
+    }
+    const int nx = grid.nx(), ny = grid.ny(), nz = grid.nz();
+    PressureSystem system;
+    system.matrix.resize(nx, ny, nz);
+    system.rhs.assign(system.matrix.size(), 0.0);
+    PoissonMatrix& a = system.matrix;
+    std::vector<double>& b = system.rhs;
+    const Array3<double>& phi = interface.phi;
+    bool has_dirichlet = false;
+    for (int axis = 0; axis < 3; ++axis) {
+        Array3<double>& off = off_diagonal(a, axis);
+        const Array3<double>& kappa = interface.kappa(axis);
+        for_each_interior_face(grid, axis, [&](int i, int j, int k, int li, int lj, int lk) {
+            const std::size_t hi = phi.index(i, j, k);
+            const std::size_t lo = phi.index(li, lj, lk);
+            const FaceCoupling face = classify_face(phi[lo], phi[hi], kappa(i, j, k), phases, mode,
+                                                    options.min_liquid_fraction);
+            switch (face.kind) {
+                case FaceCoupling::Kind::none:
+                    break;
+                case FaceCoupling::Kind::coupled:
+                    a.diag[lo] += face.beta;
+                    a.diag[hi] += face.beta;
+                    off[lo] = -face.beta;
+                    b[lo] -= face.beta * face.jump;
+                    b[hi] += face.beta * face.jump;
+                    break;
+                case FaceCoupling::Kind::dirichlet_lo:
+                    a.diag[lo] += face.beta;
+                    b[lo] += face.beta * face.boundary_pressure;
+                    has_dirichlet = true;
+                    break;
+                case FaceCoupling::Kind::dirichlet_hi:
+                    a.diag[hi] += face.beta;
+                    b[hi] += face.beta * face.boundary_pressure;
+                    has_dirichlet = true;
+                    break;
+            }
+        });
+    }
+    const double flux_scale = grid.dx() * grid.dx() / dt;
+    for (int k = 0; k < nz; ++k) {
+        for (int j = 0; j < ny; ++j) {
+            for (int i = 0; i < nx; ++i) {
+                const std::size_t c = phi.index(i, j, k);
+                if (!is_unknown(phi[c], mode)) {
+                    continue;
+                }
+                b[c] -= flux_scale * grid.divergence(i, j, k);
+                if (a.diag[c] <= 0.0) {
+                    // An unknown cell with no open face (a 1-cell box): nothing to solve.
+                    b[c] = 0.0;
+                }
+            }
+        }
+    }
+    system.singular = !has_dirichlet;
+    return system;
+}
+
+SolveResult solve_pressure_system(const PressureSystem& system, const PressureOptions& options,
+                                  Array3<double>& pressure) {
+    options.validate();
+    const PoissonMatrix& a = system.matrix;
+    std::vector<double> solution;
+    SolveResult result;
+    switch (options.solver) {
+        case PressureSolver::mic0_pcg: {
+            const Mic0Preconditioner preconditioner(a, options.mic0);
+            result = solve_pcg(a, system.rhs, preconditioner, options.iteration, system.singular,
+                               solution);
+            break;
+        }
+        case PressureSolver::multigrid_pcg: {
+            const MultigridPreconditioner preconditioner(a, options.multigrid);
+            result = solve_pcg(a, system.rhs, preconditioner, options.iteration, system.singular,
+                               solution);
+            break;
+        }
+        case PressureSolver::eigen_ic_cg:
+            result = solve_eigen_ic_cg(a, system.rhs, options.iteration, system.singular, solution);
+            break;
+    }
+    pressure.resize(a.ni(), a.nj(), a.nk(), 0.0);
+    pressure.storage() = std::move(solution);
+    return result;
+}
+
+void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
+                             const PhaseOptions& phases, FluidMode mode, double dt,
+                             const PressureOptions& options, const Array3<double>& pressure) {
+    const Array3<double>& phi = interface.phi;
+    const double scale = dt / grid.dx();
+    for (int axis = 0; axis < 3; ++axis) {
+        Array3<double>& velocity = grid.velocity(axis);
+        const Array3<double>& kappa = interface.kappa(axis);
+        for_each_interior_face(grid, axis, [&](int i, int j, int k, int li, int lj, int lk) {
+            const std::size_t hi = phi.index(i, j, k);
+            const std::size_t lo = phi.index(li, lj, lk);
+            const FaceCoupling face = classify_face(phi[lo], phi[hi], kappa(i, j, k), phases, mode,
+                                                    options.min_liquid_fraction);
+            double difference = 0.0;  // p(hi) − p(lo) as seen from the unknown side(s), Pa
+            switch (face.kind) {
+                case FaceCoupling::Kind::none:
+                    return;
+                case FaceCoupling::Kind::coupled:
+                    difference = pressure[hi] - pressure[lo] - face.jump;
+                    break;
+                case FaceCoupling::Kind::dirichlet_lo:
+                    difference = face.boundary_pressure - pressure[lo];
+                    break;
+                case FaceCoupling::Kind::dirichlet_hi:
+                    difference = pressure[hi] - face.boundary_pressure;
+                    break;
+            }
+            velocity(i, j, k) -= scale * face.beta * difference;
+        });
+    }
+}
+
+double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface, FluidMode mode) {
+    double largest = 0.0;
+    for (int k = 0; k < grid.nz(); ++k) {
+        for (int j = 0; j < grid.ny(); ++j) {
+            for (int i = 0; i < grid.nx(); ++i) {
+                if (is_unknown(interface.phi(i, j, k), mode)) {
+                    largest = std::max(largest, std::abs(grid.divergence(i, j, k)));
+                }
+            }
+        }
+    }
+    return largest;
+}
+
+ProjectionResult project(MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,
+                         FluidMode mode, double dt, const PressureOptions& options,
+                         Array3<double>& pressure) {
+    const PressureSystem system = build_pressure_system(grid, interface, phases, mode, dt, options);
+    ProjectionResult result;
+    result.solve = solve_pressure_system(system, options, pressure);
+    apply_pressure_gradient(grid, interface, phases, mode, dt, options, pressure);
+    result.max_divergence = max_fluid_divergence(grid, interface, mode);
+    return result;
+}
+
+}  // namespace meniscus::fluid

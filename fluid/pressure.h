@@ -1,0 +1,88 @@
+#pragma once
+/// \file Pressure projection with the ghost fluid method (Liu, Fedkiw & Kang 2000; Gibou et al.
+/// 2002 for the free-surface Dirichlet condition).
+///
+/// Solves ∇·(1/ρ ∇p) = ∇·u*/Δt on the cells of the MacGrid and sets u = u* − Δt/ρ ∇p on every face
+/// between two unknowns, so that the discrete divergence of each unknown cell vanishes.
+/// Scaled symmetric positive (semi-)definite system, per unknown cell c:
+///   Σ_faces f β_f (p_c − p_nb) = −(dx/Δt) Σ_f (outward u*_f) − Σ_f (±β_f J_f),
+/// with β_f = 1/ρ_f (ρ_f from the liquid fraction θ of the face, see face_density()) and J_f the
+/// jump p(hi side) − p(lo side) of face_pressure_jump() (p_liquid − p_gas = σκ).
+/// Wall faces are not unknowns: their stored normal velocity is kept (zero-flux walls give a
+/// Neumann condition). In free_surface mode only liquid cells are unknowns; a face to a gas cell
+/// uses the ghost value that puts p = σκ at the θ-weighted interface position, adding β/θ to the
+/// diagonal (θ clamped below by min_liquid_fraction). Pressure in Pa.
+
+#include <vector>
+
+#include "fluid/array3.h"
+#include "fluid/interface_input.h"
+#include "fluid/mac_grid.h"
+#include "fluid/mic0.h"
+#include "fluid/multigrid.h"
+#include "fluid/phases.h"
+#include "fluid/poisson_matrix.h"
+#include "fluid/solve_result.h"
+
+namespace meniscus::fluid {
+
+/// Linear solver used for the pressure Poisson system.
+enum class PressureSolver {
+    mic0_pcg,       ///< PCG with the MIC(0) preconditioner (sequential preconditioner)
+    multigrid_pcg,  ///< PCG with a multigrid V-cycle preconditioner (TBB-parallel)
+    eigen_ic_cg     ///< reference: Eigen ConjugateGradient + IncompleteCholesky on a CSR copy
+};
+
+/// Options of the pressure projection.
+struct PressureOptions {
+    PressureSolver solver = PressureSolver::multigrid_pcg;
+    IterativeSolverOptions iteration;     ///< relative residual tolerance and iteration cap
+    double min_liquid_fraction = 1.0e-3;  ///< lower clamp of θ for free-surface ghost faces, (0, 1]
+    Mic0Options mic0;
+    MultigridOptions multigrid;
+
+    /// Throws std::invalid_argument naming the field when out of range.
+    void validate() const;
+};
+
+/// The assembled system: matrix over all nx·ny·nz cells (inactive rows zero), right-hand side and
+/// whether A is singular (pure Neumann: two_phase in a closed box, or free_surface without gas).
+struct PressureSystem {
+    PoissonMatrix matrix;
+    std::vector<double> rhs;
+    bool singular = false;
+};
+
+/// Assembles the pressure system for the current face velocities u* of `grid` (see file comment).
+/// `dt` in seconds (> 0). Throws std::invalid_argument if `interface` is not sized for `grid`.
+PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& interface,
+                                     const PhaseOptions& phases, FluidMode mode, double dt,
+                                     const PressureOptions& options);
+
+/// Solves `system` with options.solver; writes the pressure (Pa) to `pressure` (nx × ny × nz,
+/// zero in cells that are not unknowns; mean zero when the system is singular).
+SolveResult solve_pressure_system(const PressureSystem& system, const PressureOptions& options,
+                                  Array3<double>& pressure);
+
+/// u ← u − Δt/ρ_f ∇p on every face adjacent to an unknown cell (ghost-fluid gradients with the
+/// σκ jump; free-surface faces use the interface Dirichlet value). Wall faces are untouched.
+void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
+                             const PhaseOptions& phases, FluidMode mode, double dt,
+                             const PressureOptions& options, const Array3<double>& pressure);
+
+/// Largest |∇·u| (1/s) over the unknown cells of the pressure system (all cells in two_phase,
+/// liquid cells in free_surface).
+double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface, FluidMode mode);
+
+/// Result of project().
+struct ProjectionResult {
+    SolveResult solve;            ///< linear solve outcome
+    double max_divergence = 0.0;  ///< max |∇·u| over unknown cells after projection, 1/s
+};
+
+/// Full projection: build, solve, apply the gradient. `pressure` receives p (Pa).
+ProjectionResult project(MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,
+                         FluidMode mode, double dt, const PressureOptions& options,
+                         Array3<double>& pressure);
+
+}  // namespace meniscus::fluid

@@ -1,0 +1,271 @@
+// Pressure projection: hydrostatics, the σκ jump and divergence-free output, for every backend.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <tuple>
+
+#include "fluid/pressure.h"
+
+namespace meniscus::fluid {
+namespace {
+
+constexpr double GRAVITY = 9.81;     // m/s², acting along −z
+constexpr double TIGHT_TOL = 1e-10;  // relative residual for the exactness tests
+
+PressureOptions tight_options(PressureSolver solver) {
+    PressureOptions options;
+    options.solver = solver;
+    options.iteration.tolerance = TIGHT_TOL;
+    options.iteration.max_iterations = 2000;
+    return options;
+}
+
+/// Flat interface at height h: liquid below (φ = z − h < 0).
+InterfaceInput flat_interface(const MacGrid& grid, double h, double kappa) {
+    InterfaceInput interface(grid);
+    for (int k = 0; k < grid.nz(); ++k) {
+        for (int j = 0; j < grid.ny(); ++j) {
+            for (int i = 0; i < grid.nx(); ++i) {
+                interface.phi(i, j, k) = grid.cell_centre(i, j, k).z() - h;
+            }
+        }
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        interface.kappa(axis).fill(kappa);
+    }
+    return interface;
+}
+
+/// Exact hydrostatic pressure up to a constant: liquid below h, gas above.
+double hydrostatic(double z, double h, double rho_liquid, double rho_gas) {
+    return z < h ? -rho_liquid * GRAVITY * z
+                 : -rho_liquid * GRAVITY * h - rho_gas * GRAVITY * (z - h);
+}
+
+/// Sets the interior w faces to the velocity gravity adds in dt (u* = g dt).
+void add_gravity(MacGrid& grid, double dt) {
+    for (int k = 1; k < grid.nz(); ++k) {
+        for (int j = 0; j < grid.ny(); ++j) {
+            for (int i = 0; i < grid.nx(); ++i) {
+                grid.w()(i, j, k) -= GRAVITY * dt;
+            }
+        }
+    }
+}
+
+double max_velocity(const MacGrid& grid) {
+    return grid.max_abs_velocity().maxCoeff();
+}
+
+class PressureSolverTest : public ::testing::TestWithParam<PressureSolver> {};
+
+TEST_P(PressureSolverTest, TwoPhaseStillWaterIsHydrostaticAtDensityRatio1000) {
+    const int n = 16;
+    MacGrid grid(n, n, n, 1.0 / n);
+    PhaseOptions phases;
+    phases.rho_liquid = 1000.0;
+    phases.rho_gas = 1.0;
+    phases.sigma = 0.0;
+    const double h = 0.53;  // not on a cell centre or a face
+    const InterfaceInput interface = flat_interface(grid, h, 0.0);
+    const double dt = 1e-2;
+    add_gravity(grid, dt);
+    Array3<double> pressure;
+    const ProjectionResult result = project(grid, interface, phases, FluidMode::two_phase, dt,
+                                            tight_options(GetParam()), pressure);
+    ASSERT_TRUE(result.solve.converged) << "residual " << result.solve.residual;
+    // Still water stays still.
+    EXPECT_LT(max_velocity(grid), 1e-7 * GRAVITY * dt);
+    // Pressure is the exact hydrostatic profile up to a constant.
+    double offset = pressure(0, 0, 0) - hydrostatic(grid.cell_centre(0, 0, 0).z(), h, 1000.0, 1.0);
+    double max_error = 0.0;
+    for (int k = 0; k < n; ++k) {
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                const double exact = hydrostatic(grid.cell_centre(i, j, k).z(), h, 1000.0, 1.0);
+                max_error = std::max(max_error, std::abs(pressure(i, j, k) - offset - exact));
+            }
+        }
+    }
+    const double scale = phases.rho_liquid * GRAVITY * h;
+    EXPECT_LT(max_error, 1e-7 * scale) << "max hydrostatic error " << max_error << " Pa";
+}
+
+TEST_P(PressureSolverTest, FreeSurfaceStillWaterIsHydrostatic) {
+    const int n = 16;
+    MacGrid grid(n, n, n, 1.0 / n);
+    PhaseOptions phases;
+    phases.sigma = 0.0;
+    const double h = 0.61;
+    const InterfaceInput interface = flat_interface(grid, h, 0.0);
+    const double dt = 1e-2;
+    add_gravity(grid, dt);
+    Array3<double> pressure;
+    const ProjectionResult result = project(grid, interface, phases, FluidMode::free_surface, dt,
+                                            tight_options(GetParam()), pressure);
+    ASSERT_TRUE(result.solve.converged);
+    // Liquid faces are still; gas faces (not solved) keep u*.
+    double max_liquid_w = 0.0;
+    double max_error = 0.0;
+    for (int k = 0; k < n; ++k) {
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                const double z = grid.cell_centre(i, j, k).z();
+                if (z < h) {
+                    max_liquid_w = std::max({max_liquid_w, std::abs(grid.w()(i, j, k)),
+                                             std::abs(grid.w()(i, j, k + 1))});
+                    const double exact = phases.rho_liquid * GRAVITY * (h - z);
+                    max_error = std::max(max_error, std::abs(pressure(i, j, k) - exact));
+                }
+            }
+        }
+    }
+    EXPECT_LT(max_liquid_w, 1e-7 * GRAVITY * dt);
+    EXPECT_LT(max_error, 1e-7 * phases.rho_liquid * GRAVITY * h) << max_error << " Pa";
+}
+
+TEST_P(PressureSolverTest, FlatInterfaceWithConstantCurvatureJumpsBySigmaKappa) {
+    const int n = 16;
+    MacGrid grid(n, n, n, 1.0 / n);
+    PhaseOptions phases;
+    phases.rho_liquid = 1000.0;
+    phases.rho_gas = 1.0;
+    phases.sigma = 0.07;
+    const double kappa = 8.0;
+    const double h = 0.47;
+    const InterfaceInput interface = flat_interface(grid, h, kappa);
+    for (FluidMode mode : {FluidMode::two_phase, FluidMode::free_surface}) {
+        grid.w().fill(0.0);
+        Array3<double> pressure;
+        const ProjectionResult result =
+            project(grid, interface, phases, mode, 1e-3, tight_options(GetParam()), pressure);
+        ASSERT_TRUE(result.solve.converged);
+        EXPECT_LT(max_velocity(grid), 1e-12);
+        double max_error = 0.0;
+        for (int k = 0; k < n; ++k) {
+            for (int j = 0; j < n; ++j) {
+                for (int i = 0; i < n; ++i) {
+                    const bool liquid = interface.phi(i, j, k) < 0.0;
+                    if (mode == FluidMode::two_phase && liquid) {
+                        // p_liquid − p_gas = σκ between any liquid cell and the gas above it.
+                        const double jump = pressure(i, j, k) - pressure(i, j, n - 1);
+                        max_error = std::max(max_error, std::abs(jump - phases.sigma * kappa));
+                    } else if (mode == FluidMode::free_surface && liquid) {
+                        max_error =
+                            std::max(max_error, std::abs(pressure(i, j, k) - phases.sigma * kappa));
+                    }
+                }
+            }
+        }
+        EXPECT_LT(max_error, 1e-8 * phases.sigma * kappa)
+            << (mode == FluidMode::two_phase ? "two_phase" : "free_surface");
+    }
+}
+
+TEST_P(PressureSolverTest, ProjectedVelocityIsDivergenceFreeAroundAGasBubble) {
+    const int n = 24;
+    MacGrid grid(n, n, n, 1.0 / n);
+    PhaseOptions phases;
+    phases.rho_liquid = 1000.0;
+    phases.rho_gas = 1.0;
+    const Eigen::Vector3d centre(0.5, 0.45, 0.52);
+    const double radius = 0.25;
+    InterfaceInput interface(grid);
+    for (int k = 0; k < n; ++k) {
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                interface.phi(i, j, k) = radius - (grid.cell_centre(i, j, k) - centre).norm();
+            }
+        }
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        interface.kappa(axis).fill(-2.0 / radius);  // gas bubble: the liquid side is concave
+    }
+    for (FluidMode mode : {FluidMode::two_phase, FluidMode::free_surface}) {
+        std::mt19937 rng(7);
+        std::uniform_real_distribution<double> random(-1.0, 1.0);
+        for (int axis = 0; axis < 3; ++axis) {
+            for (double& value : grid.velocity(axis).storage()) {
+                value = random(rng);
+            }
+        }
+        grid.zero_wall_normal_velocity();
+        const double before = max_fluid_divergence(grid, interface, mode);
+        PressureOptions options = tight_options(GetParam());
+        options.iteration.tolerance = 1e-9;
+        Array3<double> pressure;
+        const ProjectionResult result =
+            project(grid, interface, phases, mode, 1e-3, options, pressure);
+        ASSERT_TRUE(result.solve.converged);
+        EXPECT_LT(result.max_divergence, 1e-6 * before)
+            << "before " << before << " after " << result.max_divergence;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllBackends, PressureSolverTest,
+                         ::testing::Values(PressureSolver::mic0_pcg, PressureSolver::multigrid_pcg,
+                                           PressureSolver::eigen_ic_cg),
+                         [](const ::testing::TestParamInfo<PressureSolver>& param_info) {
+                             switch (param_info.param) {
+                                 case PressureSolver::mic0_pcg:
+                                     return std::string("mic0_pcg");
+                                 case PressureSolver::multigrid_pcg:
+                                     return std::string("multigrid_pcg");
+                                 case PressureSolver::eigen_ic_cg:
+                                     return std::string("eigen_ic_cg");
+                             }
+                             return std::string("unknown");
+                         });
+
+TEST(PressureBackends, AllBackendsAgreeOnABubbleSystem) {
+    const int n = 20;
+    MacGrid grid(n, n, n, 0.05);
+    PhaseOptions phases;
+    InterfaceInput interface(grid);
+    for (int k = 0; k < n; ++k) {
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                interface.phi(i, j, k) =
+                    0.3 - (grid.cell_centre(i, j, k) - Eigen::Vector3d(0.5, 0.5, 0.4)).norm();
+            }
+        }
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        interface.kappa(axis).fill(-2.0 / 0.3);
+    }
+    add_gravity(grid, 1e-3);
+    Array3<double> p_mic, p_mg, p_eigen;
+    const PressureSystem system =
+        build_pressure_system(grid, interface, phases, FluidMode::two_phase, 1e-3, {});
+    ASSERT_TRUE(system.singular);
+    ASSERT_TRUE(
+        solve_pressure_system(system, tight_options(PressureSolver::mic0_pcg), p_mic).converged);
+    ASSERT_TRUE(solve_pressure_system(system, tight_options(PressureSolver::multigrid_pcg), p_mg)
+                    .converged);
+    ASSERT_TRUE(solve_pressure_system(system, tight_options(PressureSolver::eigen_ic_cg), p_eigen)
+                    .converged);
+    double scale = 0.0, diff_mg = 0.0, diff_eigen = 0.0;
+    for (std::size_t c = 0; c < p_mic.size(); ++c) {
+        scale = std::max(scale, std::abs(p_mic[c]));
+        diff_mg = std::max(diff_mg, std::abs(p_mg[c] - p_mic[c]));
+        diff_eigen = std::max(diff_eigen, std::abs(p_eigen[c] - p_mic[c]));
+    }
+    EXPECT_LT(diff_mg, 1e-6 * scale);
+    EXPECT_LT(diff_eigen, 1e-6 * scale);
+}
+
+TEST(PressureOptions, ValidateNamesTheField) {
+    PressureOptions options;
+    options.min_liquid_fraction = 0.0;
+    try {
+        options.validate();
+        FAIL() << "expected std::invalid_argument";
+    } catch (const std::invalid_argument& error) {
+        EXPECT_NE(std::string(error.what()).find("min_liquid_fraction"), std::string::npos);
+    }
+}
+
+}  // namespace
+}  // namespace meniscus::fluid
