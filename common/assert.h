@@ -28,10 +28,10 @@ namespace detail {
 }  // namespace meniscus
 
 #if defined(MENISCUS_ENABLE_ASSERTS)
-#define MENISCUS_ASSERT(condition, message)                                                   \
-    do {                                                                                      \
-        if (!(condition))                                                                     \
-            ::meniscus::detail::assertion_failed(#condition, __FILE__, __LINE__, (message));  \
+#define MENISCUS_ASSERT(condition, message)                                                  \
+    do {                                                                                     \
+        if (!(condition))                                                                    \
+            ::meniscus::detail::assertion_failed(#condition, __FILE__, __LINE__, (message)); \
     } while (false)
 #else
 #define MENISCUS_ASSERT(condition, message) \

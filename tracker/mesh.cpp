@@ -17,7 +17,9 @@ void erase_value(std::vector<int>& list, int value) {
     list.pop_back();
 }
 
-bool contains(const Triangle& t, int vi) { return t[0] == vi || t[1] == vi || t[2] == vi; }
+bool contains(const Triangle& t, int vi) {
+    return t[0] == vi || t[1] == vi || t[2] == vi;
+}
 
 constexpr Triangle DEAD_TRIANGLE = {INVALID_INDEX, INVALID_INDEX, INVALID_INDEX};
 constexpr Edge DEAD_EDGE = {INVALID_INDEX, INVALID_INDEX};
@@ -66,26 +68,28 @@ int SurfaceMesh::count_live_vertices() const {
 
 int SurfaceMesh::count_live_triangles() const {
     int n = 0;
-    for (const Triangle& t : m_triangles) n += t[0] >= 0 ? 1 : 0;
+    for (const Triangle& t : m_triangles)
+        n += t[0] >= 0 ? 1 : 0;
     return n;
 }
 
 int SurfaceMesh::count_live_edges() const {
     int n = 0;
-    for (const Edge& e : m_edges) n += e[0] >= 0 ? 1 : 0;
+    for (const Edge& e : m_edges)
+        n += e[0] >= 0 ? 1 : 0;
     return n;
 }
 
 bool SurfaceMesh::has_dead_elements() const {
-    return count_live_vertices() != num_vertices() ||
-           count_live_triangles() != num_triangles() || count_live_edges() != num_edges();
+    return count_live_vertices() != num_vertices() || count_live_triangles() != num_triangles() ||
+           count_live_edges() != num_edges();
 }
 
 void SurfaceMesh::set_positions(const std::vector<Vec3>& p) {
     if (p.size() != m_positions.size())
-        throw std::invalid_argument("SurfaceMesh::set_positions: got " +
-                                    std::to_string(p.size()) + " positions for " +
-                                    std::to_string(m_positions.size()) + " vertices");
+        throw std::invalid_argument("SurfaceMesh::set_positions: got " + std::to_string(p.size()) +
+                                    " positions for " + std::to_string(m_positions.size()) +
+                                    " vertices");
     m_positions = p;
 }
 
@@ -96,7 +100,8 @@ int SurfaceMesh::find_edge(int v0, int v1) const {
     const int lo = std::min(v0, v1), hi = std::max(v0, v1);
     for (int ei : shorter) {
         const Edge& e = m_edges[static_cast<size_t>(ei)];
-        if (e[0] == lo && e[1] == hi) return ei;
+        if (e[0] == lo && e[1] == hi)
+            return ei;
     }
     return INVALID_INDEX;
 }
@@ -104,7 +109,8 @@ int SurfaceMesh::find_edge(int v0, int v1) const {
 int SurfaceMesh::find_triangle(int v0, int v1, int v2) const {
     for (int ti : vertex_triangles(v0)) {
         const Triangle& t = triangle(ti);
-        if (contains(t, v1) && contains(t, v2)) return ti;
+        if (contains(t, v1) && contains(t, v2))
+            return ti;
     }
     return INVALID_INDEX;
 }
@@ -113,7 +119,8 @@ int SurfaceMesh::opposite_vertex(int ti, int ei) const {
     const Triangle& t = triangle(ti);
     const Edge& e = edge(ei);
     for (int vi : t)
-        if (vi != e[0] && vi != e[1]) return vi;
+        if (vi != e[0] && vi != e[1])
+            return vi;
     MENISCUS_ASSERT(false, "edge is not an edge of the triangle");
     return INVALID_INDEX;
 }
@@ -122,8 +129,10 @@ int SurfaceMesh::edge_orientation_in_triangle(int ti, int ei) const {
     const Triangle& t = triangle(ti);
     const Edge& e = edge(ei);
     for (int k = 0; k < 3; ++k) {
-        if (t[k] == e[0] && t[(k + 1) % 3] == e[1]) return +1;
-        if (t[k] == e[1] && t[(k + 1) % 3] == e[0]) return -1;
+        if (t[k] == e[0] && t[(k + 1) % 3] == e[1])
+            return +1;
+        if (t[k] == e[1] && t[(k + 1) % 3] == e[0])
+            return -1;
     }
     MENISCUS_ASSERT(false, "edge is not an edge of the triangle");
     return 0;
@@ -131,7 +140,8 @@ int SurfaceMesh::edge_orientation_in_triangle(int ti, int ei) const {
 
 bool SurfaceMesh::is_boundary_vertex(int vi) const {
     for (int ei : vertex_edges(vi))
-        if (is_boundary_edge(ei)) return true;
+        if (is_boundary_edge(ei))
+            return true;
     return false;
 }
 
@@ -147,7 +157,8 @@ int SurfaceMesh::add_vertex(const Vec3& p) {
     m_vertex_triangles.emplace_back();
     m_vertex_edges.emplace_back();
     const int vi = num_vertices() - 1;
-    for (MeshObserver* o : m_observers) o->on_vertex_added(vi);
+    for (MeshObserver* o : m_observers)
+        o->on_vertex_added(vi);
     return vi;
 }
 
@@ -175,7 +186,8 @@ void SurfaceMesh::attach_triangle(int ti) {
     for (int k = 0; k < 3; ++k) {
         const int a = t[k], b = t[(k + 1) % 3];
         int ei = find_edge(a, b);
-        if (ei == INVALID_INDEX) ei = add_edge(a, b);
+        if (ei == INVALID_INDEX)
+            ei = add_edge(a, b);
         tri_edges[k] = ei;
         m_edge_triangles[static_cast<size_t>(ei)].push_back(ti);
         m_vertex_triangles[static_cast<size_t>(t[k])].push_back(ti);
@@ -189,7 +201,8 @@ void SurfaceMesh::detach_triangle(int ti) {
         erase_value(m_vertex_triangles[static_cast<size_t>(t[k])], ti);
         auto& et = m_edge_triangles[static_cast<size_t>(tri_edges[k])];
         erase_value(et, ti);
-        if (et.empty()) remove_edge(tri_edges[k]);
+        if (et.empty())
+            remove_edge(tri_edges[k]);
     }
 }
 
@@ -200,9 +213,9 @@ int SurfaceMesh::add_triangle(const Triangle& t, const LabelPair& labels) {
                                         " does not exist");
     }
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
-        throw std::invalid_argument("SurfaceMesh::add_triangle: triangle (" +
-                                    std::to_string(t[0]) + ", " + std::to_string(t[1]) + ", " +
-                                    std::to_string(t[2]) + ") repeats a vertex");
+        throw std::invalid_argument("SurfaceMesh::add_triangle: triangle (" + std::to_string(t[0]) +
+                                    ", " + std::to_string(t[1]) + ", " + std::to_string(t[2]) +
+                                    ") repeats a vertex");
     const int ti = num_triangles();
     m_triangles.push_back(t);
     m_labels.push_back(labels);
@@ -240,14 +253,16 @@ int SurfaceMesh::split_edge(int ei, const Vec3& position, double s) {
         const LabelPair l = labels(ti);
         // Rotate so that t = (a, b, c) with (a, b) the split edge in the triangle's direction.
         int k = 0;
-        while (!((t[k] == e[0] || t[k] == e[1]) && (t[(k + 1) % 3] == e[0] || t[(k + 1) % 3] == e[1])))
+        while (
+            !((t[k] == e[0] || t[k] == e[1]) && (t[(k + 1) % 3] == e[0] || t[(k + 1) % 3] == e[1])))
             ++k;
         const int a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
         remove_triangle(ti);
         add_triangle({a, m, c}, l);
         add_triangle({m, b, c}, l);
     }
-    for (MeshObserver* o : m_observers) o->on_edge_split(e[0], e[1], m, s);
+    for (MeshObserver* o : m_observers)
+        o->on_edge_split(e[0], e[1], m, s);
     return m;
 }
 
@@ -280,19 +295,22 @@ void SurfaceMesh::collapse_edge(int ei, int kept_vi, const Vec3& position, doubl
     MENISCUS_ASSERT(edge_alive(ei), "collapsing a dead edge");
     const int removed_vi = other_vertex(ei, kept_vi);
     const std::vector<int> on_edge = edge_triangles(ei);
-    for (int ti : on_edge) remove_triangle(ti);
+    for (int ti : on_edge)
+        remove_triangle(ti);
     const std::vector<int> rewired = vertex_triangles(removed_vi);
     for (int ti : rewired) {
         Triangle t = triangle(ti);
         const LabelPair l = labels(ti);
         for (int& vi : t)
-            if (vi == removed_vi) vi = kept_vi;
+            if (vi == removed_vi)
+                vi = kept_vi;
         remove_triangle(ti);
         add_triangle(t, l);
     }
     m_positions[static_cast<size_t>(kept_vi)] = position;
     remove_vertex(removed_vi);
-    for (MeshObserver* o : m_observers) o->on_edge_collapse(kept_vi, removed_vi, s);
+    for (MeshObserver* o : m_observers)
+        o->on_edge_collapse(kept_vi, removed_vi, s);
 }
 
 int SurfaceMesh::duplicate_vertex(int vi, const std::vector<int>& triangles,
@@ -310,11 +328,13 @@ int SurfaceMesh::duplicate_vertex(int vi, const std::vector<int>& triangles,
                                         std::to_string(vi));
         const LabelPair l = labels(ti);
         for (int& v : t)
-            if (v == vi) v = copy;
+            if (v == vi)
+                v = copy;
         remove_triangle(ti);
         add_triangle(t, l);
     }
-    for (MeshObserver* o : m_observers) o->on_vertex_duplicated(vi, copy);
+    for (MeshObserver* o : m_observers)
+        o->on_vertex_duplicated(vi, copy);
     return copy;
 }
 
@@ -322,12 +342,14 @@ std::vector<int> SurfaceMesh::compact() {
     std::vector<int> vertex_map(m_positions.size(), INVALID_INDEX);
     int nv = 0;
     for (size_t vi = 0; vi < m_positions.size(); ++vi)
-        if (m_vertex_alive[vi]) vertex_map[vi] = nv++;
+        if (m_vertex_alive[vi])
+            vertex_map[vi] = nv++;
 
     std::vector<Vec3> positions;
     positions.reserve(static_cast<size_t>(nv));
     for (size_t vi = 0; vi < m_positions.size(); ++vi)
-        if (m_vertex_alive[vi]) positions.push_back(m_positions[vi]);
+        if (m_vertex_alive[vi])
+            positions.push_back(m_positions[vi]);
 
     std::vector<Triangle> triangles;
     std::vector<LabelPair> labels;
@@ -335,7 +357,8 @@ std::vector<int> SurfaceMesh::compact() {
     labels.reserve(m_triangles.size());
     for (size_t ti = 0; ti < m_triangles.size(); ++ti) {
         const Triangle& t = m_triangles[ti];
-        if (t[0] < 0) continue;
+        if (t[0] < 0)
+            continue;
         triangles.push_back({vertex_map[static_cast<size_t>(t[0])],
                              vertex_map[static_cast<size_t>(t[1])],
                              vertex_map[static_cast<size_t>(t[2])]});
@@ -344,12 +367,14 @@ std::vector<int> SurfaceMesh::compact() {
     std::vector<MeshObserver*> observers = std::move(m_observers);
     *this = SurfaceMesh(std::move(positions), triangles, labels);
     m_observers = std::move(observers);
-    for (MeshObserver* o : m_observers) o->on_compact(vertex_map);
+    for (MeshObserver* o : m_observers)
+        o->on_compact(vertex_map);
     return vertex_map;
 }
 
 void SurfaceMesh::add_observer(MeshObserver* observer) {
-    if (observer == nullptr) throw std::invalid_argument("SurfaceMesh::add_observer: null");
+    if (observer == nullptr)
+        throw std::invalid_argument("SurfaceMesh::add_observer: null");
     if (std::find(m_observers.begin(), m_observers.end(), observer) == m_observers.end())
         m_observers.push_back(observer);
 }

@@ -14,6 +14,7 @@
 /// exactly one triangle.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <array>
 #include <cstdint>

@@ -18,7 +18,8 @@ double tet6(const Vec3& ref, const Vec3& a, const Vec3& b, const Vec3& c) {
 
 Vec3 reference_point(const SurfaceMesh& mesh) {
     for (int vi = 0; vi < mesh.num_vertices(); ++vi)
-        if (mesh.vertex_alive(vi)) return mesh.position(vi);
+        if (mesh.vertex_alive(vi))
+            return mesh.position(vi);
     return Vec3::Zero();
 }
 
@@ -28,7 +29,8 @@ double enclosed_volume(const SurfaceMesh& mesh) {
     const Vec3 ref = reference_point(mesh);
     double six_v = 0.0;
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
-        if (!mesh.triangle_alive(ti)) continue;
+        if (!mesh.triangle_alive(ti))
+            continue;
         const Triangle& t = mesh.triangle(ti);
         six_v += tet6(ref, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
     }
@@ -38,7 +40,8 @@ double enclosed_volume(const SurfaceMesh& mesh) {
 double surface_area(const SurfaceMesh& mesh) {
     double twice = 0.0;
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
-        if (!mesh.triangle_alive(ti)) continue;
+        if (!mesh.triangle_alive(ti))
+            continue;
         const Triangle& t = mesh.triangle(ti);
         const Vec3& a = mesh.position(t[0]);
         twice += (mesh.position(t[1]) - a).cross(mesh.position(t[2]) - a).norm();
@@ -51,7 +54,8 @@ EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh) {
     s.min = std::numeric_limits<double>::infinity();
     double sum = 0.0;
     for (int ei = 0; ei < mesh.num_edges(); ++ei) {
-        if (!mesh.edge_alive(ei)) continue;
+        if (!mesh.edge_alive(ei))
+            continue;
         const Edge& e = mesh.edge(ei);
         const double l = (mesh.position(e[1]) - mesh.position(e[0])).norm();
         s.min = std::min(s.min, l);
@@ -59,7 +63,8 @@ EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh) {
         sum += l;
         ++s.count;
     }
-    if (s.count == 0) return EdgeLengthStats{};
+    if (s.count == 0)
+        return EdgeLengthStats{};
     s.mean = sum / s.count;
     return s;
 }
@@ -68,7 +73,8 @@ AngleStats angle_stats(const SurfaceMesh& mesh) {
     AngleStats s{std::numeric_limits<double>::infinity(), 0.0};
     bool any = false;
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
-        if (!mesh.triangle_alive(ti)) continue;
+        if (!mesh.triangle_alive(ti))
+            continue;
         const Triangle& t = mesh.triangle(ti);
         for (int k = 0; k < 3; ++k) {
             const Vec3 u = mesh.position(t[(k + 1) % 3]) - mesh.position(t[k]);
@@ -97,7 +103,8 @@ Components triangle_components(const SurfaceMesh& mesh) {
             stack.pop_back();
             for (int ei : mesh.triangle_edges(ti)) {
                 for (int tj : mesh.edge_triangles(ei)) {
-                    if (c.triangle_component[static_cast<size_t>(tj)] >= 0) continue;
+                    if (c.triangle_component[static_cast<size_t>(tj)] >= 0)
+                        continue;
                     c.triangle_component[static_cast<size_t>(tj)] = id;
                     stack.push_back(tj);
                 }
@@ -111,12 +118,14 @@ std::vector<double> component_volumes(const SurfaceMesh& mesh, const Components&
     std::vector<double> six_v(static_cast<size_t>(components.count), 0.0);
     const Vec3 ref = reference_point(mesh);
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
-        if (!mesh.triangle_alive(ti)) continue;
+        if (!mesh.triangle_alive(ti))
+            continue;
         const Triangle& t = mesh.triangle(ti);
         six_v[static_cast<size_t>(components.triangle_component[static_cast<size_t>(ti)])] +=
             tet6(ref, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
     }
-    for (double& v : six_v) v /= 6.0;
+    for (double& v : six_v)
+        v /= 6.0;
     return six_v;
 }
 

@@ -25,7 +25,8 @@ public:
     explicit Collector(int max) : m_max(max) {}
     bool full() const { return m_max > 0 && static_cast<int>(m_out.size()) >= m_max; }
     void add(ViolationKind kind, int index, std::string message) {
-        if (!full()) m_out.push_back({kind, index, std::move(message)});
+        if (!full())
+            m_out.push_back({kind, index, std::move(message)});
     }
     std::vector<MeshViolation> take() { return std::move(m_out); }
 
@@ -37,7 +38,8 @@ private:
 void check_triangles(const SurfaceMesh& mesh, const ValidationOptions& options, Collector& out) {
     std::map<std::array<int, 3>, int> seen;
     for (int ti = 0; ti < mesh.num_triangles() && !out.full(); ++ti) {
-        if (!mesh.triangle_alive(ti)) continue;
+        if (!mesh.triangle_alive(ti))
+            continue;
         const Triangle& t = mesh.triangle(ti);
         bool indices_ok = true;
         for (int vi : t) {
@@ -48,7 +50,8 @@ void check_triangles(const SurfaceMesh& mesh, const ValidationOptions& options, 
                 indices_ok = false;
             }
         }
-        if (!indices_ok) continue;
+        if (!indices_ok)
+            continue;
         if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
             out.add(ViolationKind::RepeatedVertex, ti,
                     describe_triangle(mesh, ti) + " repeats a vertex");
@@ -77,11 +80,13 @@ void check_triangles(const SurfaceMesh& mesh, const ValidationOptions& options, 
 
 void check_edges(const SurfaceMesh& mesh, const ValidationOptions& options, Collector& out) {
     for (int ei = 0; ei < mesh.num_edges() && !out.full(); ++ei) {
-        if (!mesh.edge_alive(ei)) continue;
+        if (!mesh.edge_alive(ei))
+            continue;
         const auto& tris = mesh.edge_triangles(ei);
         const int n = static_cast<int>(tris.size());
         if (n == 0) {
-            out.add(ViolationKind::AdjacencyMismatch, ei, describe_edge(mesh, ei) + " has no triangle");
+            out.add(ViolationKind::AdjacencyMismatch, ei,
+                    describe_edge(mesh, ei) + " has no triangle");
             continue;
         }
         if (n == 1) {
@@ -97,7 +102,8 @@ void check_edges(const SurfaceMesh& mesh, const ValidationOptions& options, Coll
             continue;
         }
         int forward = 0;
-        for (int ti : tris) forward += mesh.edge_orientation_in_triangle(ti, ei) > 0 ? 1 : 0;
+        for (int ti : tris)
+            forward += mesh.edge_orientation_in_triangle(ti, ei) > 0 ? 1 : 0;
         if (2 * forward != n)
             out.add(ViolationKind::InconsistentOrientation, ei,
                     describe_edge(mesh, ei) + " is traversed " + std::to_string(forward) +
@@ -108,7 +114,8 @@ void check_edges(const SurfaceMesh& mesh, const ValidationOptions& options, Coll
 
 void check_adjacency(const SurfaceMesh& mesh, Collector& out) {
     for (int ti = 0; ti < mesh.num_triangles() && !out.full(); ++ti) {
-        if (!mesh.triangle_alive(ti)) continue;
+        if (!mesh.triangle_alive(ti))
+            continue;
         const Triangle& t = mesh.triangle(ti);
         for (int k = 0; k < 3; ++k) {
             const int ei = mesh.triangle_edges(ti)[k];
@@ -127,7 +134,8 @@ void check_adjacency(const SurfaceMesh& mesh, Collector& out) {
 
 }  // namespace
 
-std::vector<MeshViolation> validate_mesh(const SurfaceMesh& mesh, const ValidationOptions& options) {
+std::vector<MeshViolation> validate_mesh(const SurfaceMesh& mesh,
+                                         const ValidationOptions& options) {
     Collector out(options.max_violations);
     check_triangles(mesh, options, out);
     check_edges(mesh, options, out);
@@ -137,14 +145,22 @@ std::vector<MeshViolation> validate_mesh(const SurfaceMesh& mesh, const Validati
 
 const char* to_string(ViolationKind kind) {
     switch (kind) {
-        case ViolationKind::InvalidVertexIndex: return "invalid vertex index";
-        case ViolationKind::RepeatedVertex: return "repeated vertex";
-        case ViolationKind::DuplicateTriangle: return "duplicate triangle";
-        case ViolationKind::BoundaryEdge: return "boundary edge";
-        case ViolationKind::OddEdgeValence: return "odd edge valence";
-        case ViolationKind::InconsistentOrientation: return "inconsistent orientation";
-        case ViolationKind::DegenerateTriangle: return "degenerate triangle";
-        case ViolationKind::AdjacencyMismatch: return "adjacency mismatch";
+        case ViolationKind::InvalidVertexIndex:
+            return "invalid vertex index";
+        case ViolationKind::RepeatedVertex:
+            return "repeated vertex";
+        case ViolationKind::DuplicateTriangle:
+            return "duplicate triangle";
+        case ViolationKind::BoundaryEdge:
+            return "boundary edge";
+        case ViolationKind::OddEdgeValence:
+            return "odd edge valence";
+        case ViolationKind::InconsistentOrientation:
+            return "inconsistent orientation";
+        case ViolationKind::DegenerateTriangle:
+            return "degenerate triangle";
+        case ViolationKind::AdjacencyMismatch:
+            return "adjacency mismatch";
     }
     return "unknown";
 }

@@ -1,0 +1,152 @@
+#include "tracker/mesh.h"
+#include "tracker/mesh_measures.h"
+#include "tracker/mesh_validate.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+namespace meniscus::tracker {
+namespace {
+
+/// Regular tetrahedron with outward normals.
+SurfaceMesh tetrahedron() {
+    return SurfaceMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                       {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}});
+}
+
+/// Octahedron (every vertex valence 4) with outward normals.
+SurfaceMesh octahedron() {
+    return SurfaceMesh(
+        {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
+        {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
+}
+
+bool has_kind(const std::vector<MeshViolation>& v, ViolationKind kind) {
+    return std::any_of(v.begin(), v.end(), [&](const MeshViolation& m) { return m.kind == kind; });
+}
+
+TEST(SurfaceMesh, BuildsAdjacency) {
+    const SurfaceMesh m = tetrahedron();
+    EXPECT_EQ(m.count_live_vertices(), 4);
+    EXPECT_EQ(m.count_live_edges(), 6);
+    EXPECT_EQ(m.count_live_triangles(), 4);
+    for (int ei = 0; ei < m.num_edges(); ++ei)
+        EXPECT_EQ(m.edge_triangles(ei).size(), 2u);
+    for (int vi = 0; vi < 4; ++vi)
+        EXPECT_EQ(m.vertex_triangles(vi).size(), 3u);
+    EXPECT_TRUE(validate_mesh(m).empty());
+    EXPECT_NEAR(enclosed_volume(m), 1.0 / 6.0, 1e-15);
+    EXPECT_EQ(euler_characteristic(m), 2);
+}
+
+TEST(SurfaceMesh, RejectsBadTriangles) {
+    EXPECT_THROW(SurfaceMesh({{0, 0, 0}, {1, 0, 0}}, {{0, 1, 2}}), std::invalid_argument);
+    EXPECT_THROW(SurfaceMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 1}}),
+                 std::invalid_argument);
+}
+
+TEST(SurfaceMesh, SplitKeepsClosedAndVolume) {
+    SurfaceMesh m = octahedron();
+    const double v0 = enclosed_volume(m);
+    const int ei = m.find_edge(0, 2);
+    const int vi = m.split_edge(ei, 0.5 * (m.position(0) + m.position(2)));
+    EXPECT_EQ(m.find_edge(0, 2), INVALID_INDEX);
+    EXPECT_NE(m.find_edge(0, vi), INVALID_INDEX);
+    EXPECT_NE(m.find_edge(vi, 4), INVALID_INDEX);
+    EXPECT_EQ(m.count_live_triangles(), 10);
+    EXPECT_TRUE(validate_mesh(m).empty());
+    EXPECT_NEAR(enclosed_volume(m), v0, 1e-14);
+}
+
+TEST(SurfaceMesh, FlipReplacesDiagonal) {
+    SurfaceMesh m = octahedron();
+    // Split edge (0,2) so that the flip target (vi, 4) - (0, 2) quad exists, then flip (0, 4).
+    const int ei = m.find_edge(0, 4);
+    const auto tris = m.edge_triangles(ei);
+    const int new_edge = m.flip_edge(ei, tris[0], tris[1]);
+    const Edge e = m.edge(new_edge);
+    EXPECT_TRUE((e == Edge{2, 3}));
+    EXPECT_EQ(m.find_edge(0, 4), INVALID_INDEX);
+    EXPECT_TRUE(validate_mesh(m).empty());
+    EXPECT_THROW(
+        m.flip_edge(new_edge, m.edge_triangles(new_edge)[0], m.edge_triangles(new_edge)[0]),
+        std::invalid_argument);
+}
+
+TEST(SurfaceMesh, CollapseAndCompactNotifyObservers) {
+    struct Recorder : MeshObserver {
+        int collapses = 0;
+        std::vector<int> map;
+        void on_edge_collapse(int, int, double) override { ++collapses; }
+        void on_compact(const std::vector<int>& m) override { map = m; }
+    } recorder;
+    SurfaceMesh m = octahedron();
+    m.split_edge(m.find_edge(0, 2), {0.5, 0.5, 0});  // vertex 6, valence 4
+    m.add_observer(&recorder);
+    const int ei = m.find_edge(0, 6);
+    m.collapse_edge(ei, 0, m.position(0), 0.0);
+    EXPECT_EQ(recorder.collapses, 1);
+    EXPECT_FALSE(m.vertex_alive(6));
+    EXPECT_TRUE(validate_mesh(m).empty());
+    EXPECT_TRUE(m.has_dead_elements());
+    m.compact();
+    EXPECT_FALSE(m.has_dead_elements());
+    ASSERT_EQ(recorder.map.size(), 7u);
+    EXPECT_EQ(recorder.map[6], INVALID_INDEX);
+    EXPECT_EQ(recorder.map[5], 5);
+    EXPECT_EQ(m.count_live_triangles(), 8);
+    EXPECT_TRUE(validate_mesh(m).empty());
+}
+
+TEST(SurfaceMesh, DuplicateVertexSeparatesFans) {
+    // Two tetrahedra sharing only vertex 0: a singular vertex. Duplicating one fan separates them.
+    SurfaceMesh m(
+        {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}},
+        {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}, {0, 5, 4}, {0, 4, 6}, {0, 6, 5}, {4, 5, 6}});
+    EXPECT_EQ(triangle_components(m).count, 2);
+    EXPECT_EQ(euler_characteristic(m), 3);  // one vertex shared: 7 − 12 + 8
+    const std::vector<int> fan = {4, 5, 6};
+    m.duplicate_vertex(0, fan, {-1e-3, -1e-3, -1e-3});
+    EXPECT_EQ(euler_characteristic(m), 4);
+    EXPECT_TRUE(validate_mesh(m).empty());
+}
+
+TEST(MeshValidate, ListsEveryViolation) {
+    // Open, inconsistently oriented, duplicated and degenerate, all at once.
+    SurfaceMesh m({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {2, 0, 0}, {0, 0, 1}},
+                  {{0, 1, 2}, {0, 1, 4}, {2, 1, 0}, {0, 1, 3}});
+    const auto v = validate_mesh(m);
+    EXPECT_TRUE(has_kind(v, ViolationKind::BoundaryEdge));
+    EXPECT_TRUE(has_kind(v, ViolationKind::DuplicateTriangle));
+    EXPECT_TRUE(has_kind(v, ViolationKind::DegenerateTriangle));
+    EXPECT_TRUE(has_kind(v, ViolationKind::InconsistentOrientation) ||
+                has_kind(v, ViolationKind::OddEdgeValence) ||
+                has_kind(v, ViolationKind::BoundaryEdge));
+    EXPECT_GE(v.size(), 4u);
+    ValidationOptions open;
+    open.allow_boundary = true;
+    EXPECT_FALSE(has_kind(validate_mesh(m, open), ViolationKind::BoundaryEdge));
+}
+
+TEST(MeshValidate, DetectsInconsistentOrientation) {
+    SurfaceMesh m = tetrahedron();
+    // Re-add one triangle reversed.
+    SurfaceMesh flipped({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                        {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 3, 2}});
+    EXPECT_TRUE(has_kind(validate_mesh(flipped), ViolationKind::InconsistentOrientation));
+    EXPECT_TRUE(validate_mesh(m).empty());
+}
+
+TEST(MeshValidate, AcceptsEvenNonManifoldEdge) {
+    // Two tetrahedra sharing edge (0,1): four triangles on it, two each way.
+    SurfaceMesh m(
+        {{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, 0.3, 1}, {0.5, -1, 0}, {0.5, -0.3, -1}},
+        {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}, {0, 1, 4}, {0, 5, 1}, {0, 4, 5}, {1, 5, 4}});
+    const auto v = validate_mesh(m);
+    EXPECT_TRUE(v.empty()) << v.front().message;
+    EXPECT_TRUE(m.is_nonmanifold_edge(m.find_edge(0, 1)));
+}
+
+}  // namespace
+}  // namespace meniscus::tracker

@@ -1,0 +1,227 @@
+#include "tracker/implicit_mesher.h"
+
+#include "tracker/isotropic_remesh.h"
+#include "tracker/mesh_measures.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <unordered_map>
+#include <vector>
+
+namespace meniscus::tracker {
+
+namespace {
+
+/// Grid spacing of marching tetrahedra relative to the requested edge length: the raw
+/// surface is then a bit finer than the target and remeshing mostly collapses and smooths.
+constexpr double GRID_SPACING_FRACTION = 0.7;
+/// Bisection/regula-falsi steps for each edge crossing.
+constexpr int ROOT_ITERATIONS = 30;
+/// Grid cells of padding around the shape's bounds.
+constexpr int PADDING_CELLS = 2;
+/// Keep crossings this fraction of a grid edge away from grid nodes (no zero-length edges).
+constexpr double MIN_CROSSING_PARAMETER = 1e-3;
+
+/// Cube corner offsets indexed by bits (x = bit 0, y = bit 1, z = bit 2).
+constexpr std::array<std::array<int, 3>, 8> CORNER = {
+    {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}}};
+/// Kuhn subdivision: six tetrahedra from corner 0 to corner 7 along each axis permutation.
+constexpr std::array<std::array<int, 4>, 6> KUHN_TETS = {
+    {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}}};
+
+class MarchingTetrahedra {
+public:
+    MarchingTetrahedra(const ImplicitShape& shape, double h) : m_shape(shape), m_h(h) {
+        const Box3 b = shape.bounds();
+        if (b.isEmpty())
+            throw std::runtime_error("shape has empty bounds");
+        m_origin = b.min() - Vec3::Constant(PADDING_CELLS * h);
+        for (int i = 0; i < 3; ++i)
+            m_n[i] = static_cast<int>(std::ceil(b.sizes()[i] / h)) + 2 * PADDING_CELLS + 1;
+        const double nodes = double(m_n[0]) * m_n[1] * m_n[2];
+        if (nodes > MAX_NODES)
+            throw std::invalid_argument(
+                "edge_length: too small for the shape's size (the meshing grid would need " +
+                std::to_string(static_cast<long long>(nodes)) + " nodes)");
+        m_phi.resize(static_cast<size_t>(nodes));
+        for (int k = 0; k < m_n[2]; ++k)
+            for (int j = 0; j < m_n[1]; ++j)
+                for (int i = 0; i < m_n[0]; ++i) {
+                    double v = shape.value(node_position(i, j, k));
+                    if (v == 0.0)
+                        v = std::numeric_limits<double>::min();  // zero counts as outside
+                    m_phi[node_index(i, j, k)] = v;
+                }
+    }
+
+    SurfaceMesh build() {
+        for (int k = 0; k + 1 < m_n[2]; ++k)
+            for (int j = 0; j + 1 < m_n[1]; ++j)
+                for (int i = 0; i + 1 < m_n[0]; ++i)
+                    march_cube(i, j, k);
+        return SurfaceMesh(std::move(m_positions), m_triangles);
+    }
+
+private:
+    static constexpr double MAX_NODES = 2.0e8;
+
+    size_t node_index(int i, int j, int k) const {
+        return (static_cast<size_t>(k) * m_n[1] + j) * m_n[0] + i;
+    }
+    Vec3 node_position(int i, int j, int k) const { return m_origin + m_h * Vec3(i, j, k); }
+
+    int crossing_vertex(size_t n0, const Vec3& p0, size_t n1, const Vec3& p1) {
+        const std::uint64_t key =
+            n0 < n1 ? (std::uint64_t(n0) << 32 | n1) : (std::uint64_t(n1) << 32 | n0);
+        auto it = m_edge_vertex.find(key);
+        if (it != m_edge_vertex.end())
+            return it->second;
+        // Regula falsi (Illinois) on φ along the segment, bracketed by the node values.
+        double s0 = 0.0, s1 = 1.0, f0 = m_phi[n0], f1 = m_phi[n1];
+        double s = f0 / (f0 - f1);
+        for (int it2 = 0; it2 < ROOT_ITERATIONS; ++it2) {
+            s = (s0 * f1 - s1 * f0) / (f1 - f0);
+            const double f = m_shape.value(p0 + s * (p1 - p0));
+            if (f == 0.0)
+                break;
+            if ((f < 0.0) == (f0 < 0.0)) {
+                s0 = s;
+                f0 = f;
+                f1 *= 0.5;
+            } else {
+                s1 = s;
+                f1 = f;
+                f0 *= 0.5;
+            }
+        }
+        s = std::clamp(s, MIN_CROSSING_PARAMETER, 1.0 - MIN_CROSSING_PARAMETER);
+        const int vi = static_cast<int>(m_positions.size());
+        m_positions.push_back(p0 + s * (p1 - p0));
+        m_edge_vertex.emplace(key, vi);
+        return vi;
+    }
+
+    void emit(int a, int b, int c, const Vec3& inside_to_outside) {
+        const Vec3 n = (m_positions[b] - m_positions[a]).cross(m_positions[c] - m_positions[a]);
+        if (n.dot(inside_to_outside) >= 0.0)
+            m_triangles.push_back({a, b, c});
+        else
+            m_triangles.push_back({a, c, b});
+    }
+
+    void march_cube(int i, int j, int k) {
+        std::array<size_t, 8> node;
+        std::array<Vec3, 8> pos;
+        for (int c = 0; c < 8; ++c) {
+            node[c] = node_index(i + CORNER[c][0], j + CORNER[c][1], k + CORNER[c][2]);
+            pos[c] = node_position(i + CORNER[c][0], j + CORNER[c][1], k + CORNER[c][2]);
+        }
+        for (const auto& tet : KUHN_TETS) {
+            std::array<int, 4> in, out;
+            int n_in = 0, n_out = 0;
+            for (int c : tet)
+                (m_phi[node[c]] < 0.0 ? in[n_in++] : out[n_out++]) = c;
+            if (n_in == 0 || n_out == 0)
+                continue;
+            Vec3 c_in = Vec3::Zero(), c_out = Vec3::Zero();
+            for (int q = 0; q < n_in; ++q)
+                c_in += pos[in[q]] / n_in;
+            for (int q = 0; q < n_out; ++q)
+                c_out += pos[out[q]] / n_out;
+            const Vec3 dir = c_out - c_in;
+            const auto cross = [&](int a, int b) {
+                return crossing_vertex(node[a], pos[a], node[b], pos[b]);
+            };
+            if (n_in == 1 || n_out == 1) {
+                const bool lone_in = n_in == 1;
+                const int lone = lone_in ? in[0] : out[0];
+                const auto& others = lone_in ? out : in;
+                emit(cross(lone, others[0]), cross(lone, others[1]), cross(lone, others[2]), dir);
+            } else {
+                // Two in, two out: a quad, split along its shorter diagonal.
+                const int a = cross(in[0], out[0]), b = cross(in[0], out[1]);
+                const int c = cross(in[1], out[1]), d = cross(in[1], out[0]);
+                if ((m_positions[a] - m_positions[c]).squaredNorm() <=
+                    (m_positions[b] - m_positions[d]).squaredNorm()) {
+                    emit(a, b, c, dir);
+                    emit(a, c, d, dir);
+                } else {
+                    emit(a, b, d, dir);
+                    emit(b, c, d, dir);
+                }
+            }
+        }
+    }
+
+    const ImplicitShape& m_shape;
+    double m_h;
+    Vec3 m_origin;
+    std::array<int, 3> m_n{};
+    std::vector<double> m_phi;
+    std::vector<Vec3> m_positions;
+    std::vector<Triangle> m_triangles;
+    std::unordered_map<std::uint64_t, int> m_edge_vertex;
+};
+
+}  // namespace
+
+void ImplicitMeshOptions::validate() const {
+    if (!(edge_length > 0.0) || !std::isfinite(edge_length))
+        throw std::invalid_argument("edge_length: expected a number > 0");
+    if (remesh_iterations < 0)
+        throw std::invalid_argument("remesh_iterations: expected an integer >= 0");
+    if (projection_iterations < 0)
+        throw std::invalid_argument("projection_iterations: expected an integer >= 0");
+}
+
+Vec3 project_to_zero_set(const ImplicitShape& shape, const Vec3& x, int iterations) {
+    Vec3 p = x;
+    for (int it = 0; it < iterations; ++it) {
+        const double v = shape.value(p);
+        if (v == 0.0)
+            break;
+        const Vec3 g = shape.gradient(p);
+        const double g2 = g.squaredNorm();
+        if (!(g2 > 0.0))
+            break;
+        p -= (v / g2) * g;
+    }
+    return p;
+}
+
+SurfaceMesh mesh_implicit_shape(const ImplicitShape& shape, const ImplicitMeshOptions& options,
+                                ImplicitMeshReport* report) {
+    options.validate();
+    MarchingTetrahedra marching(shape, GRID_SPACING_FRACTION * options.edge_length);
+    SurfaceMesh mesh = marching.build();
+    if (mesh.count_live_triangles() == 0)
+        throw std::runtime_error("the shape has no surface at edge_length " +
+                                 std::to_string(options.edge_length) +
+                                 " (is it smaller than one edge?)");
+    IsotropicRemeshOptions remesh;
+    remesh.target_edge_length = options.edge_length;
+    remesh.iterations = options.remesh_iterations;
+    const int newton = options.projection_iterations;
+    isotropic_remesh(mesh, remesh, [&shape, newton](const Vec3& p) {
+        return project_to_zero_set(shape, p, newton);
+    });
+    if (report) {
+        report->vertices = mesh.count_live_vertices();
+        report->triangles = mesh.count_live_triangles();
+        report->mean_edge_length = edge_length_stats(mesh).mean;
+        const AngleStats angles = angle_stats(mesh);
+        report->min_angle_degrees = angles.min_degrees;
+        report->max_angle_degrees = angles.max_degrees;
+        report->max_abs_phi = 0.0;
+        for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+            report->max_abs_phi =
+                std::max(report->max_abs_phi, std::abs(shape.value(mesh.position(vi))));
+    }
+    return mesh;
+}
+
+}  // namespace meniscus::tracker

@@ -1,0 +1,273 @@
+#include "tracker/implicit_shape.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace meniscus::tracker {
+
+using Eigen::Vector3d;
+
+namespace {
+
+/// Finite-difference step as a fraction of the shape's bounding-box diagonal.
+constexpr double GRADIENT_STEP_FRACTION = 1e-7;
+
+void require_positive(double v, const char* what) {
+    if (!(v > 0.0) || !std::isfinite(v))
+        throw std::invalid_argument(std::string(what) + " must be a finite number > 0, got " +
+                                    std::to_string(v));
+}
+
+Vector3d normalized_axis(const Vector3d& axis) {
+    const double n = axis.norm();
+    if (!(n > 0.0) || !std::isfinite(n))
+        throw std::invalid_argument("axis must be a non-zero finite vector");
+    return axis / n;
+}
+
+/// Polynomial smooth minimum (C¹) with blend radius k ≥ 0; equals min(a, b) when |a−b| ≥ k.
+double smooth_min(double a, double b, double k) {
+    if (k <= 0.0)
+        return std::min(a, b);
+    const double h = std::max(k - std::abs(a - b), 0.0) / k;
+    return std::min(a, b) - h * h * k * 0.25;
+}
+
+class Sphere final : public ImplicitShape {
+public:
+    Sphere(const Vector3d& c, double r) : m_c(c), m_r(r) { require_positive(r, "sphere radius"); }
+    double value(const Vector3d& x) const override { return (x - m_c).norm() - m_r; }
+    Vector3d gradient(const Vector3d& x) const override {
+        const Vector3d d = x - m_c;
+        const double n = d.norm();
+        return n > 0.0 ? Vector3d(d / n) : Vector3d::UnitX();
+    }
+    Box3 bounds() const override {
+        return Box3(m_c - Vector3d::Constant(m_r), m_c + Vector3d::Constant(m_r));
+    }
+
+private:
+    Vector3d m_c;
+    double m_r;
+};
+
+class Ellipsoid final : public ImplicitShape {
+public:
+    Ellipsoid(const Vector3d& c, const Vector3d& r) : m_c(c), m_r(r) {
+        for (int i = 0; i < 3; ++i)
+            require_positive(r[i], "ellipsoid radii");
+    }
+    // (|x/r| − 1)·min(r): exact zero set, correct sign, a lower bound on distance scale.
+    double value(const Vector3d& x) const override {
+        return ((x - m_c).cwiseQuotient(m_r).norm() - 1.0) * m_r.minCoeff();
+    }
+    Box3 bounds() const override { return Box3(m_c - m_r, m_c + m_r); }
+
+private:
+    Vector3d m_c, m_r;
+};
+
+class Box final : public ImplicitShape {
+public:
+    Box(const Vector3d& lo, const Vector3d& hi) : m_lo(lo), m_hi(hi) {
+        for (int i = 0; i < 3; ++i)
+            require_positive(hi[i] - lo[i], "box size (max - min)");
+    }
+    double value(const Vector3d& x) const override {
+        const Vector3d c = 0.5 * (m_lo + m_hi), h = 0.5 * (m_hi - m_lo);
+        const Vector3d q = (x - c).cwiseAbs() - h;
+        return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+    }
+    Box3 bounds() const override { return Box3(m_lo, m_hi); }
+
+private:
+    Vector3d m_lo, m_hi;
+};
+
+class Cylinder final : public ImplicitShape {
+public:
+    Cylinder(const Vector3d& c, const Vector3d& axis, double r, double height)
+        : m_c(c), m_a(normalized_axis(axis)), m_r(r), m_half(0.5 * height) {
+        require_positive(r, "cylinder radius");
+        require_positive(height, "cylinder height");
+    }
+    double value(const Vector3d& x) const override {
+        const Vector3d d = x - m_c;
+        const double along = d.dot(m_a);
+        const double radial = (d - along * m_a).norm();
+        const double qx = radial - m_r, qy = std::abs(along) - m_half;
+        return std::hypot(std::max(qx, 0.0), std::max(qy, 0.0)) + std::min(std::max(qx, qy), 0.0);
+    }
+    Box3 bounds() const override {
+        const Vector3d ext = m_a.cwiseAbs() * m_half +
+                             m_r * (Vector3d::Ones() - m_a.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
+        return Box3(m_c - ext, m_c + ext);
+    }
+
+private:
+    Vector3d m_c, m_a;
+    double m_r, m_half;
+};
+
+class Torus final : public ImplicitShape {
+public:
+    Torus(const Vector3d& c, const Vector3d& axis, double major, double minor)
+        : m_c(c), m_a(normalized_axis(axis)), m_R(major), m_r(minor) {
+        require_positive(minor, "torus minor_radius");
+        require_positive(major - minor, "torus major_radius - minor_radius");
+    }
+    double value(const Vector3d& x) const override {
+        const Vector3d d = x - m_c;
+        const double along = d.dot(m_a);
+        const double radial = (d - along * m_a).norm();
+        return std::hypot(radial - m_R, along) - m_r;
+    }
+    Box3 bounds() const override {
+        const double e = m_R + m_r;
+        return Box3(m_c - Vector3d::Constant(e), m_c + Vector3d::Constant(e));
+    }
+
+private:
+    Vector3d m_c, m_a;
+    double m_R, m_r;
+};
+
+class Dumbbell final : public ImplicitShape {
+public:
+    Dumbbell(const Vector3d& c, double bulb, double separation, double handle, double blend)
+        : m_c(c), m_bulb(bulb), m_half(0.5 * separation), m_handle(handle), m_blend(blend) {
+        require_positive(bulb, "dumbbell bulb_radius");
+        require_positive(separation, "dumbbell separation");
+        require_positive(handle, "dumbbell handle_radius");
+        require_positive(bulb - handle, "dumbbell bulb_radius - handle_radius");
+        if (!(blend >= 0.0))
+            throw std::invalid_argument("dumbbell blend_radius must be >= 0");
+    }
+    double value(const Vector3d& x) const override {
+        const Vector3d d = x - m_c;
+        const double left = (d - Vector3d(-m_half, 0, 0)).norm() - m_bulb;
+        const double right = (d - Vector3d(m_half, 0, 0)).norm() - m_bulb;
+        const double radial = std::hypot(d.y(), d.z()) - m_handle;
+        const double cap = std::abs(d.x()) - m_half;  // handle runs between the bulb centres
+        const double handle = std::hypot(std::max(radial, 0.0), std::max(cap, 0.0)) +
+                              std::min(std::max(radial, cap), 0.0);
+        return smooth_min(std::min(left, right), handle, m_blend);
+    }
+    Box3 bounds() const override {
+        const Vector3d e(m_half + m_bulb, m_bulb, m_bulb);
+        return Box3(m_c - e, m_c + e);
+    }
+
+private:
+    Vector3d m_c;
+    double m_bulb, m_half, m_handle, m_blend;
+};
+
+class Combination final : public ImplicitShape {
+public:
+    enum class Op { Union, Intersection };
+    Combination(std::vector<ShapePtr> shapes, Op op) : m_shapes(std::move(shapes)), m_op(op) {
+        if (m_shapes.empty())
+            throw std::invalid_argument("a union/intersection needs shapes");
+        for (const auto& s : m_shapes)
+            if (!s)
+                throw std::invalid_argument("a union/intersection got a null shape");
+    }
+    double value(const Vector3d& x) const override {
+        double v = m_shapes.front()->value(x);
+        for (size_t i = 1; i < m_shapes.size(); ++i) {
+            const double vi = m_shapes[i]->value(x);
+            v = m_op == Op::Union ? std::min(v, vi) : std::max(v, vi);
+        }
+        return v;
+    }
+    Vector3d gradient(const Vector3d& x) const override { return active(x).gradient(x); }
+    Box3 bounds() const override {
+        Box3 b = m_shapes.front()->bounds();
+        for (size_t i = 1; i < m_shapes.size(); ++i)
+            b = m_op == Op::Union ? b.merged(m_shapes[i]->bounds())
+                                  : b.intersection(m_shapes[i]->bounds());
+        return b;
+    }
+
+private:
+    const ImplicitShape& active(const Vector3d& x) const {
+        size_t best = 0;
+        double v = m_shapes.front()->value(x);
+        for (size_t i = 1; i < m_shapes.size(); ++i) {
+            const double vi = m_shapes[i]->value(x);
+            if (m_op == Op::Union ? vi < v : vi > v) {
+                v = vi;
+                best = i;
+            }
+        }
+        return *m_shapes[best];
+    }
+    std::vector<ShapePtr> m_shapes;
+    Op m_op;
+};
+
+class Difference final : public ImplicitShape {
+public:
+    Difference(ShapePtr a, ShapePtr b) : m_a(std::move(a)), m_b(std::move(b)) {
+        if (!m_a || !m_b)
+            throw std::invalid_argument("a difference got a null shape");
+    }
+    double value(const Vector3d& x) const override {
+        return std::max(m_a->value(x), -m_b->value(x));
+    }
+    Vector3d gradient(const Vector3d& x) const override {
+        return m_a->value(x) >= -m_b->value(x) ? m_a->gradient(x) : Vector3d(-m_b->gradient(x));
+    }
+    Box3 bounds() const override { return m_a->bounds(); }
+
+private:
+    ShapePtr m_a, m_b;
+};
+
+}  // namespace
+
+Vector3d ImplicitShape::gradient(const Vector3d& x) const {
+    const double h = std::max(bounds().diagonal().norm(), 1e-300) * GRADIENT_STEP_FRACTION;
+    Vector3d g;
+    for (int i = 0; i < 3; ++i) {
+        Vector3d e = Vector3d::Zero();
+        e[i] = h;
+        g[i] = (value(x + e) - value(x - e)) / (2.0 * h);
+    }
+    return g;
+}
+
+ShapePtr make_sphere(const Vector3d& center, double radius) {
+    return std::make_shared<Sphere>(center, radius);
+}
+ShapePtr make_ellipsoid(const Vector3d& center, const Vector3d& radii) {
+    return std::make_shared<Ellipsoid>(center, radii);
+}
+ShapePtr make_box(const Vector3d& min_corner, const Vector3d& max_corner) {
+    return std::make_shared<Box>(min_corner, max_corner);
+}
+ShapePtr make_cylinder(const Vector3d& center, const Vector3d& axis, double radius, double height) {
+    return std::make_shared<Cylinder>(center, axis, radius, height);
+}
+ShapePtr make_torus(const Vector3d& center, const Vector3d& axis, double major_radius,
+                    double minor_radius) {
+    return std::make_shared<Torus>(center, axis, major_radius, minor_radius);
+}
+ShapePtr make_dumbbell(const Vector3d& center, double bulb_radius, double separation,
+                       double handle_radius, double blend_radius) {
+    return std::make_shared<Dumbbell>(center, bulb_radius, separation, handle_radius, blend_radius);
+}
+ShapePtr make_union(std::vector<ShapePtr> shapes) {
+    return std::make_shared<Combination>(std::move(shapes), Combination::Op::Union);
+}
+ShapePtr make_intersection(std::vector<ShapePtr> shapes) {
+    return std::make_shared<Combination>(std::move(shapes), Combination::Op::Intersection);
+}
+ShapePtr make_difference(ShapePtr a, ShapePtr b) {
+    return std::make_shared<Difference>(std::move(a), std::move(b));
+}
+
+}  // namespace meniscus::tracker

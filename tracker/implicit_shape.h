@@ -1,0 +1,60 @@
+#pragma once
+/// \file Implicit shapes for initial surfaces: φ(x) < 0 inside, > 0 outside, 0 on the surface.
+///
+/// Primitives return exact signed distances where a closed form exists (sphere, box, capped
+/// cylinder, torus) and a sign-correct, Lipschitz approximation otherwise (ellipsoid, smooth
+/// unions). CSG combinations use min/max, which keep the zero set exact but make φ only a
+/// bound on the distance away from it. Units: metres.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <memory>
+#include <vector>
+
+namespace meniscus::tracker {
+
+using Box3 = Eigen::AlignedBox3d;
+
+/// A closed region of space given by an implicit function.
+class ImplicitShape {
+public:
+    virtual ~ImplicitShape() = default;
+    /// Signed value at x: negative inside, positive outside (a distance or a bound on it).
+    virtual double value(const Eigen::Vector3d& x) const = 0;
+    /// Gradient of value() at x (central differences at a scale relative to the bounds unless a
+    /// shape knows better). Points outward.
+    virtual Eigen::Vector3d gradient(const Eigen::Vector3d& x) const;
+    /// A box containing the whole region (the zero set and the inside).
+    virtual Box3 bounds() const = 0;
+};
+
+using ShapePtr = std::shared_ptr<const ImplicitShape>;
+
+/// Sphere of `radius` > 0 around `center`. Throws std::invalid_argument on radius ≤ 0.
+ShapePtr make_sphere(const Eigen::Vector3d& center, double radius);
+/// Axis-aligned ellipsoid with semi-axes `radii` (all > 0).
+ShapePtr make_ellipsoid(const Eigen::Vector3d& center, const Eigen::Vector3d& radii);
+/// Axis-aligned box between `min_corner` and `max_corner` (max > min in every axis).
+ShapePtr make_box(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& max_corner);
+/// Capped cylinder: axis through `center` along `axis` (normalized inside), `radius`, total
+/// `height` (> 0).
+ShapePtr make_cylinder(const Eigen::Vector3d& center, const Eigen::Vector3d& axis, double radius,
+                       double height);
+/// Torus around `axis` through `center`: tube centre circle `major_radius`, tube
+/// `minor_radius` (0 < minor < major).
+ShapePtr make_torus(const Eigen::Vector3d& center, const Eigen::Vector3d& axis, double major_radius,
+                    double minor_radius);
+/// Sethian-style dumbbell along x: two balls of `bulb_radius` centred at center ± (separation/2)
+/// e_x joined by a cylindrical handle of `handle_radius`, blended over `blend_radius` (≥ 0) by a
+/// smooth minimum so the surface is C¹ where the handle meets the bulbs.
+ShapePtr make_dumbbell(const Eigen::Vector3d& center, double bulb_radius, double separation,
+                       double handle_radius, double blend_radius);
+/// Union of one or more shapes (min of values).
+ShapePtr make_union(std::vector<ShapePtr> shapes);
+/// Intersection of one or more shapes (max of values).
+ShapePtr make_intersection(std::vector<ShapePtr> shapes);
+/// `a` minus `b` (max(φ_a, −φ_b)).
+ShapePtr make_difference(ShapePtr a, ShapePtr b);
+
+}  // namespace meniscus::tracker
