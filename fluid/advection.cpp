@@ -1,0 +1,129 @@
+#include "fluid/advection.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <array>
+#include <stdexcept>
+
+namespace meniscus::fluid {
+
+namespace {
+
+constexpr double HALF = 0.5;
+
+/// Velocity in cell units per second (m/s ÷ dx) at a point given in cell units.
+Eigen::Vector3d grid_velocity(const std::array<const Array3<double>*, 3>& velocity,
+                              const Eigen::Vector3d& g, double inverse_dx) {
+    return inverse_dx *
+           Eigen::Vector3d(sample_trilinear(*velocity[0], FieldLocation::x_face, g).value,
+                           sample_trilinear(*velocity[1], FieldLocation::y_face, g).value,
+                           sample_trilinear(*velocity[2], FieldLocation::z_face, g).value);
+}
+
+/// Is sample (i, j, k) of a field at `location` on a wall-normal face (kept fixed)?
+bool is_fixed_sample(FieldLocation location, const Array3<double>& field, int i, int j, int k) {
+    switch (location) {
+        case FieldLocation::x_face:
+            return i == 0 || i == field.ni() - 1;
+        case FieldLocation::y_face:
+            return j == 0 || j == field.nj() - 1;
+        case FieldLocation::z_face:
+            return k == 0 || k == field.nk() - 1;
+        case FieldLocation::cell_centre:
+            return false;
+    }
+    return false;
+}
+
+/// One semi-Lagrangian pass: out(x) = in(x − dt·u) with RK2 back-tracing; `dt` may be negative
+/// (forward trace). When bounds are requested, the min/max of the interpolation stencil is stored.
+void semi_lagrangian(const std::array<const Array3<double>*, 3>& velocity, double inverse_dx,
+                     double dt, FieldLocation location, const Array3<double>& in,
+                     Array3<double>& out, Array3<double>* lower, Array3<double>* upper) {
+    const Eigen::Vector3d offset = field_offset(location);
+    tbb::parallel_for(tbb::blocked_range<int>(0, in.nk()), [&](const tbb::blocked_range<int>& r) {
+        for (int k = r.begin(); k != r.end(); ++k) {
+            for (int j = 0; j < in.nj(); ++j) {
+                for (int i = 0; i < in.ni(); ++i) {
+                    const std::size_t c = in.index(i, j, k);
+                    if (is_fixed_sample(location, in, i, j, k)) {
+                        out[c] = in[c];
+                        if (lower != nullptr) {
+                            (*lower)[c] = in[c];
+                            (*upper)[c] = in[c];
+                        }
+                        continue;
+                    }
+                    const Eigen::Vector3d start = Eigen::Vector3d(i, j, k) + offset;
+                    const Eigen::Vector3d mid =
+                        start - HALF * dt * grid_velocity(velocity, start, inverse_dx);
+                    const Eigen::Vector3d departure =
+                        start - dt * grid_velocity(velocity, mid, inverse_dx);
+                    const TrilinearSample sample = sample_trilinear(in, location, departure);
+                    out[c] = sample.value;
+                    if (lower != nullptr) {
+                        (*lower)[c] = sample.min;
+                        (*upper)[c] = sample.max;
+                    }
+                }
+            }
+        }
+    });
+}
+
+}  // namespace
+
+void AdvectionOptions::validate() const {
+    if (scheme != AdvectionScheme::semi_lagrangian && scheme != AdvectionScheme::bfecc &&
+        scheme != AdvectionScheme::maccormack) {
+        throw std::invalid_argument("AdvectionOptions.scheme: unknown advection scheme");
+    }
+}
+
+void advect_field(const MacGrid& grid, double dt, FieldLocation location,
+                  const AdvectionOptions& options, Array3<double>& field) {
+    options.validate();
+    const std::array<const Array3<double>*, 3> velocity = {&grid.u(), &grid.v(), &grid.w()};
+    const double inverse_dx = 1.0 / grid.dx();
+    const int ni = field.ni(), nj = field.nj(), nk = field.nk();
+    Array3<double> forward(ni, nj, nk);
+    Array3<double> lower(ni, nj, nk), upper(ni, nj, nk);
+    semi_lagrangian(velocity, inverse_dx, dt, location, field, forward, &lower, &upper);
+    if (options.scheme == AdvectionScheme::semi_lagrangian) {
+        field = std::move(forward);
+        return;
+    }
+    Array3<double> backward(ni, nj, nk);
+    semi_lagrangian(velocity, inverse_dx, -dt, location, forward, backward, nullptr, nullptr);
+    Array3<double> corrected(ni, nj, nk);
+    if (options.scheme == AdvectionScheme::bfecc) {
+        // Advect φ0 + (φ0 − φ̂0)/2 forward again.
+        Array3<double> compensated(ni, nj, nk);
+        for (std::size_t c = 0; c < field.size(); ++c) {
+            compensated[c] = field[c] + HALF * (field[c] - backward[c]);
+        }
+        semi_lagrangian(velocity, inverse_dx, dt, location, compensated, corrected, nullptr,
+                        nullptr);
+    } else {
+        // MacCormack: φ1 + (φ0 − φ̂0)/2.
+        for (std::size_t c = 0; c < field.size(); ++c) {
+            corrected[c] = forward[c] + HALF * (field[c] - backward[c]);
+        }
+    }
+    for (std::size_t c = 0; c < field.size(); ++c) {
+        const double value = corrected[c];
+        field[c] = (value < lower[c] || value > upper[c]) ? forward[c] : value;
+    }
+}
+
+void advect_velocity(MacGrid& grid, double dt, const AdvectionOptions& options) {
+    const MacGrid start = grid;
+    for (int axis = 0; axis < 3; ++axis) {
+        Array3<double> component = start.velocity(axis);
+        advect_field(start, dt, face_location(axis), options, component);
+        grid.velocity(axis) = std::move(component);
+    }
+}
+
+}  // namespace meniscus::fluid

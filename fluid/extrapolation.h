@@ -1,0 +1,16 @@
+#pragma once
+/// \file Velocity extrapolation from the liquid into the void (free-surface mode).
+
+#include "fluid/interface_input.h"
+#include "fluid/mac_grid.h"
+
+namespace meniscus::fluid {
+
+/// Extends the face velocities of faces next to a liquid cell (φ < 0 on either side) into the
+/// other faces, one layer of face neighbours (same component, ±1 along each axis) at a time: an
+/// unknown face takes the mean of its known neighbours and becomes known for the next layer.
+/// Wall-normal faces are neither read nor written. Faces further than `layers` from the liquid
+/// keep their values. Throws std::invalid_argument when `layers` < 0 or the interface does not fit.
+void extrapolate_velocity(MacGrid& grid, const InterfaceInput& interface, int layers);
+
+}  // namespace meniscus::fluid

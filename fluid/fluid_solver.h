@@ -1,0 +1,86 @@
+#pragma once
+/// \file One Navier–Stokes step on the MAC grid: advection, gravity, implicit viscosity,
+/// ghost-fluid pressure projection (and velocity extrapolation into the void in free-surface mode).
+///
+/// The solver never sees the interface mesh: each step receives an InterfaceInput (φ at cell
+/// centres, negative in the liquid; κ on the faces it crosses; see interface_input.h). All
+/// quantities are SI. The box is closed: the normal velocity on every wall is zero.
+
+#include <Eigen/Core>
+
+#include "fluid/advection.h"
+#include "fluid/array3.h"
+#include "fluid/interface_input.h"
+#include "fluid/mac_grid.h"
+#include "fluid/phases.h"
+#include "fluid/pressure.h"
+#include "fluid/solve_result.h"
+#include "fluid/timestep.h"
+#include "fluid/viscosity.h"
+
+namespace meniscus::fluid {
+
+/// Everything the fluid step needs besides the grid size and the interface.
+struct FluidOptions {
+    PhaseOptions phases;
+    FluidMode mode = FluidMode::two_phase;
+    Eigen::Vector3d gravity = Eigen::Vector3d(0.0, 0.0, -9.81);  ///< m/s² (z up by default)
+    WallOptions walls;
+    AdvectionOptions advection;
+    ViscosityOptions viscosity;
+    PressureOptions pressure;
+    TimeStepOptions time_step;
+    int extrapolation_layers = 4;  ///< free_surface: face layers filled into the void (≥ 0)
+
+    /// Validates every sub-struct; throws std::invalid_argument naming the field.
+    void validate() const;
+};
+
+/// Wall-clock seconds spent in each phase of a step.
+struct StepTimings {
+    double advection = 0.0;
+    double forces = 0.0;
+    double viscosity = 0.0;
+    double pressure = 0.0;
+    double extrapolation = 0.0;
+    double total = 0.0;
+};
+
+/// What a step did.
+struct StepResult {
+    SolveResult pressure;         ///< pressure Poisson solve
+    SolveResult viscosity;        ///< viscous CG solve (0 iterations when skipped)
+    double max_divergence = 0.0;  ///< max |∇·u| over the solved cells after projection, 1/s
+    StepTimings timings;
+};
+
+/// Two-phase / free-surface incompressible flow solver on a MAC grid.
+class FluidSolver {
+public:
+    /// A solver on nx × ny × nz cells of edge dx (m), min corner `origin` (m), fluid at rest.
+    /// Throws std::invalid_argument for invalid sizes or options.
+    FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3d& origin,
+                const FluidOptions& options);
+
+    /// Advances the velocity by `dt` seconds (> 0) with the interface `interface` (sized for the
+    /// grid): advect, gravity, walls, viscosity, projection, extrapolation (free_surface).
+    /// Numerical non-convergence is reported in the result, not thrown.
+    StepResult step(double dt, const InterfaceInput& interface);
+
+    /// The time-step limits for the current velocity (CFL, viscous, capillary).
+    TimeStepLimits time_step_limits() const;
+
+    MacGrid& grid() { return m_grid; }
+    const MacGrid& grid() const { return m_grid; }
+    /// Pressure (Pa) at cell centres from the last step, nx × ny × nz; zero in the void
+    /// (free_surface); mean zero when the system is pure Neumann (two_phase).
+    const Array3<double>& pressure() const { return m_pressure; }
+    const FluidOptions& options() const { return m_options; }
+
+private:
+    FluidOptions m_options;
+    MacGrid m_grid;
+    Array3<double> m_pressure;
+};
+
+}  // namespace meniscus::fluid

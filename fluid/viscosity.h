@@ -1,0 +1,45 @@
+#pragma once
+/// \file Implicit (backward Euler) viscosity with variable μ, variational form after Batty &
+/// Bridson 2008.
+///
+/// The new face velocities minimise
+///   Σ_faces ½ ρ_f (u_f − u*_f)² + Δt Σ_cells μ_c (ε_xx² + ε_yy² + ε_zz²)
+///                                 + Δt Σ_edges μ_e · 2 (ε_xy² | ε_xz² | ε_yz²),
+/// (all multiplied by the cell volume), i.e. ρ (u − u*)/Δt = ∇·(2 μ ε(u)), ε = ½(∇u + ∇uᵀ). The
+/// diagonal strain rates live at cell centres, the shear strain rates on cell edges (ε_xy on
+/// z-parallel edges at (i·dx, j·dx, (k+½)·dx), etc.). μ_c is the viscosity of the cell's phase,
+/// μ_e the average over the (up to 4) cells around the edge, ρ_f the face density of
+/// face_density(). The system is symmetric positive definite and solved by conjugate gradients
+/// (Eigen, Jacobi preconditioner) starting from u*.
+///
+/// Boundaries: wall-normal faces keep their stored value. On a no-slip wall the tangential
+/// velocity is mirrored with opposite sign (zero at the wall) and the edge terms on that wall are
+/// weighted by the half of their dual cell inside the box; on a free-slip wall the shear stress
+/// vanishes, so the edge terms lying on that wall are dropped. In free_surface mode only
+/// faces next to a liquid cell are unknowns and the gas has μ = 0 (traction-free surface).
+
+#include "fluid/interface_input.h"
+#include "fluid/mac_grid.h"
+#include "fluid/phases.h"
+#include "fluid/solve_result.h"
+
+namespace meniscus::fluid {
+
+/// Options of the implicit viscosity step.
+struct ViscosityOptions {
+    bool enabled = true;               ///< false skips the step (inviscid flow)
+    IterativeSolverOptions iteration;  ///< CG tolerance and iteration cap
+
+    /// Throws std::invalid_argument naming the field when out of range.
+    void validate() const;
+};
+
+/// Replaces the face velocities of `grid` (u*) by the backward-Euler viscous update over `dt`
+/// seconds. Returns the CG outcome (converged with 0 iterations when there is nothing to solve:
+/// disabled, or μ = 0 everywhere). Throws std::invalid_argument when `interface` does not fit the
+/// grid or dt ≤ 0.
+SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
+                            const PhaseOptions& phases, FluidMode mode, const WallOptions& walls,
+                            double dt, const ViscosityOptions& options);
+
+}  // namespace meniscus::fluid
