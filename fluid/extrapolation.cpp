@@ -80,6 +80,11 @@ void extrapolate_velocity(MacGrid& grid, const InterfaceInput& interface, int la
                 state[newly_known[n]] = KNOWN;
             }
         }
+        for (std::size_t f = 0; f < faces.size(); ++f) {
+            if (state[f] == UNKNOWN) {
+                faces[f] = 0.0;
+            }
+        }
     }
 }
 

@@ -10,7 +10,8 @@ namespace meniscus::fluid {
 /// other faces, one layer of face neighbours (same component, ±1 along each axis) at a time: an
 /// unknown face takes the mean of its known neighbours and becomes known for the next layer.
 /// Wall-normal faces are neither read nor written. Faces further than `layers` from the liquid
-/// keep their values. Throws std::invalid_argument when `layers` < 0 or the interface does not fit.
+/// are set to zero (they carry no information and must not pollute the CFL limit). Throws
+/// std::invalid_argument when `layers` < 0 or the interface does not fit.
 void extrapolate_velocity(MacGrid& grid, const InterfaceInput& interface, int layers);
 
 }  // namespace meniscus::fluid

@@ -55,17 +55,19 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
 
     Clock::time_point start = Clock::now();
     advect_velocity(m_grid, dt, m_options.advection);
+    m_grid.zero_wall_normal_velocity();
     result.timings.advection = seconds_since(start);
 
-    start = Clock::now();
-    apply_gravity(m_grid, m_options.gravity, dt);
-    m_grid.zero_wall_normal_velocity();
-    result.timings.forces = seconds_since(start);
-
+    // Viscosity before gravity: the body force is then balanced by the pressure of the same
+    // projection, so a fluid at rest in hydrostatic equilibrium stays exactly at rest.
     start = Clock::now();
     result.viscosity = apply_viscosity(m_grid, interface, m_options.phases, m_options.mode,
                                        m_options.walls, dt, m_options.viscosity);
     result.timings.viscosity = seconds_since(start);
+
+    start = Clock::now();
+    apply_gravity(m_grid, m_options.gravity, dt);
+    result.timings.forces = seconds_since(start);
 
     start = Clock::now();
     const ProjectionResult projection = project(m_grid, interface, m_options.phases, m_options.mode,

@@ -63,7 +63,8 @@ public:
                 const FluidOptions& options);
 
     /// Advances the velocity by `dt` seconds (> 0) with the interface `interface` (sized for the
-    /// grid): advect, gravity, walls, viscosity, projection, extrapolation (free_surface).
+    /// grid): advect, viscosity, gravity, projection, extrapolation (free_surface). Gravity comes
+    /// after viscosity so that hydrostatic rest is an exact steady state of the step.
     /// Numerical non-convergence is reported in the result, not thrown.
     StepResult step(double dt, const InterfaceInput& interface);
 
