@@ -25,14 +25,30 @@ constexpr double SPLITTER = 0x1p27 + 1.0;
 /// of the bound itself. orient2d: (1+u)^4 - 1 <= 4u + 7u^2, same slack argument.
 constexpr double ORIENT3D_FILTER_BOUND = (8.0 + 128.0 * UNIT_ROUNDOFF) * UNIT_ROUNDOFF;
 constexpr double ORIENT2D_FILTER_BOUND = (4.0 + 64.0 * UNIT_ROUNDOFF) * UNIT_ROUNDOFF;
-/// Below this permanent, gradual underflow could add absolute errors the relative bound ignores.
-constexpr double FILTER_MIN_PERMANENT = 0x1p-900;
 /// Inputs whose nonzero magnitudes lie in [EXPANSION_MIN_MAGNITUDE, EXPANSION_MAX_MAGNITUDE] are
 /// multiples of 2^-352 and at most 2^300: every product of three difference components is then a
 /// multiple of 2^-1056 (>= the subnormal spacing 2^-1074) and below 2^906, so the expansion
 /// arithmetic neither underflows inexactly nor overflows. Other inputs use big integers.
 constexpr double EXPANSION_MIN_MAGNITUDE = 0x1p-300;
 constexpr double EXPANSION_MAX_MAGNITUDE = 0x1p300;
+
+/// The filters' relative bounds assume no product underflows or overflows (an underflowed
+/// product later multiplied by a huge factor would void them). Nonzero computed differences
+/// inside [FILTER_MIN_DIFFERENCE, FILTER_MAX_DIFFERENCE] guarantee that every product of up to
+/// three of them is a normal number; otherwise the exact path decides.
+constexpr double FILTER_MIN_DIFFERENCE = 0x1p-300;
+constexpr double FILTER_MAX_DIFFERENCE = 0x1p300;
+
+/// True when every value is zero or has a magnitude inside the filter's safe range (false for
+/// non-finite values).
+template <typename... Values>
+bool filter_safe(Values... values) {
+    auto safe = [](double x) {
+        const double m = std::abs(x);
+        return x == 0.0 || (m >= FILTER_MIN_DIFFERENCE && m <= FILTER_MAX_DIFFERENCE);
+    };
+    return (safe(values) && ...);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Error-free transformations.
@@ -368,7 +384,7 @@ int orient2d_impl(double ax, double ay, double bx, double by, double cx, double 
     const double det = left - right;
     const double permanent = std::abs(left) + std::abs(right);
     const double bound = ORIENT2D_FILTER_BOUND * permanent;
-    if (permanent >= FILTER_MIN_PERMANENT && (det > bound || -det > bound)) {
+    if ((det > bound || -det > bound) && filter_safe(bax, bay, cax, cay)) {
         return det > 0.0 ? 1 : -1;
     }
     return orient2d_exact(ax, ay, bx, by, cx, cy);
@@ -433,7 +449,7 @@ int orient3d_filtered(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const 
                              std::abs(bay) * (std::abs(caz_dax) + std::abs(cax_daz)) +
                              std::abs(baz) * (std::abs(cax_day) + std::abs(cay_dax));
     const double bound = ORIENT3D_FILTER_BOUND * permanent;
-    if (permanent >= FILTER_MIN_PERMANENT && (det > bound || -det > bound)) {
+    if ((det > bound || -det > bound) && filter_safe(bax, bay, baz, cax, cay, caz, dax, day, daz)) {
         return det > 0.0 ? 1 : -1;
     }
     return SIGN_UNCERTAIN;
