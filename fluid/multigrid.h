@@ -3,9 +3,10 @@
 /// pressure Poisson matrix (in the spirit of McAdams, Sifakis & Teran 2010).
 ///
 /// Cell-centred coarsening by 2 in each direction (ceil(n/2) cells); coarse face coefficients are
-/// the fine ones rediscretised on the coarse grid (½ · sum of the 2×2 fine faces covering a coarse
-/// face, which is the average fine coefficient scaled to the coarse spacing), the Dirichlet
-/// (free-surface) part of the diagonal is summed the same way; transfers are cell-centred
+/// the fine ones rediscretised on the coarse grid (for each of the 2×2 fine lines through a coarse
+/// face, the (½, 1, ½)-weighted average of the three fine faces between the two coarse centres;
+/// ½ · the sum over the lines), the Dirichlet (free-surface) part of the diagonal is summed and
+/// scaled by ½ the same way; transfers are cell-centred
 /// trilinear prolongation P and restriction Pᵀ; smoothing is red–black Gauss–Seidel, red→black
 /// before and black→red after the coarse correction so the cycle is a symmetric operator.
 

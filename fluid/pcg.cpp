@@ -68,9 +68,7 @@ SolveResult solve_pcg(const PoissonMatrix& matrix, const std::vector<double>& b,
         const double rz_new = dot(r, z);
         const double beta = rz_new / rz;
         rz = rz_new;
-        for (std::size_t c = 0; c < n; ++c) {
-            search[c] = z[c] + beta * search[c];
-        }
+        xpby(z, beta, search);
     }
     if (singular) {
         remove_active_mean(matrix, x);

@@ -5,6 +5,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <functional>
+#include <utility>
 
 namespace meniscus::fluid {
 
@@ -110,25 +111,47 @@ void axpy(double alpha, const std::vector<double>& x, std::vector<double>& y) {
                       });
 }
 
+void xpby(const std::vector<double>& x, double beta, std::vector<double>& y) {
+    const double* xv = x.data();
+    double* yv = y.data();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, y.size(), VECTOR_GRAIN),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t c = range.begin(); c != range.end(); ++c) {
+                              yv[c] = xv[c] + beta * yv[c];
+                          }
+                      });
+}
+
 void remove_active_mean(const PoissonMatrix& matrix, std::vector<double>& x) {
     const double* a_d = matrix.diag.data();
-    double sum = 0.0;
-    std::size_t count = 0;
-    for (std::size_t c = 0; c < x.size(); ++c) {
-        if (a_d[c] > 0.0) {
-            sum += x[c];
-            ++count;
-        }
-    }
-    if (count == 0) {
+    double* xv = x.data();
+    using SumCount = std::pair<double, std::size_t>;
+    const SumCount total = tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, x.size(), VECTOR_GRAIN), SumCount(0.0, 0),
+        [&](const tbb::blocked_range<std::size_t>& range, SumCount partial) {
+            for (std::size_t c = range.begin(); c != range.end(); ++c) {
+                if (a_d[c] > 0.0) {
+                    partial.first += xv[c];
+                    ++partial.second;
+                }
+            }
+            return partial;
+        },
+        [](const SumCount& a, const SumCount& b) {
+            return SumCount(a.first + b.first, a.second + b.second);
+        });
+    if (total.second == 0) {
         return;
     }
-    const double mean = sum / static_cast<double>(count);
-    for (std::size_t c = 0; c < x.size(); ++c) {
-        if (a_d[c] > 0.0) {
-            x[c] -= mean;
-        }
-    }
+    const double mean = total.first / static_cast<double>(total.second);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, x.size(), VECTOR_GRAIN),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t c = range.begin(); c != range.end(); ++c) {
+                              if (a_d[c] > 0.0) {
+                                  xv[c] -= mean;
+                              }
+                          }
+                      });
 }
 
 }  // namespace meniscus::fluid

@@ -43,6 +43,8 @@ struct PoissonMatrix {
 double dot(const std::vector<double>& a, const std::vector<double>& b);
 /// y += alpha x (TBB-parallel).
 void axpy(double alpha, const std::vector<double>& x, std::vector<double>& y);
+/// y = x + beta y (TBB-parallel).
+void xpby(const std::vector<double>& x, double beta, std::vector<double>& y);
 /// Subtracts the mean over active cells of `matrix` from x on those cells (projection onto the
 /// complement of the constant null space of a pure-Neumann operator).
 void remove_active_mean(const PoissonMatrix& matrix, std::vector<double>& x);

@@ -19,7 +19,7 @@ void set_uniform_velocity(MacGrid& grid, const Eigen::Vector3d& velocity) {
     }
 }
 
-TEST(Advection, ConstantFieldIsExactForEveryScheme) {
+TEST(FluidAdvection, ConstantFieldIsExactForEveryScheme) {
     MacGrid grid(12, 10, 8, 0.1);
     // A swirling, non-uniform velocity field.
     for (int axis = 0; axis < 3; ++axis) {
@@ -42,7 +42,7 @@ TEST(Advection, ConstantFieldIsExactForEveryScheme) {
     }
 }
 
-TEST(Advection, LinearFieldInUniformFlowIsExactAwayFromInflow) {
+TEST(FluidAdvection, LinearFieldInUniformFlowIsExactAwayFromInflow) {
     const int n = 16;
     const double dx = 1.0 / n;
     MacGrid grid(n, n, n, dx);
@@ -77,7 +77,7 @@ TEST(Advection, LinearFieldInUniformFlowIsExactAwayFromInflow) {
     }
 }
 
-TEST(Advection, LinearShearVelocityIsASteadyExactSolution) {
+TEST(FluidAdvection, LinearShearVelocityIsASteadyExactSolution) {
     // u = a + b·y, v = w = 0 is a steady solution of u_t + (u·∇)u = 0 and is linear, so every
     // scheme must keep it exactly (everywhere: the back-trace only moves along x).
     const int n = 12;
@@ -104,7 +104,7 @@ TEST(Advection, LinearShearVelocityIsASteadyExactSolution) {
     }
 }
 
-TEST(Advection, CorrectionsAreLessDiffusiveThanPlainSemiLagrangian) {
+TEST(FluidAdvection, CorrectionsAreLessDiffusiveThanPlainSemiLagrangian) {
     // Translate a smooth bump by a quarter of the box in 20 steps; compare with the exact shift.
     const int n = 48;
     const double dx = 1.0 / n;

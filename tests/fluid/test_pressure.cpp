@@ -59,9 +59,9 @@ double max_velocity(const MacGrid& grid) {
     return grid.max_abs_velocity().maxCoeff();
 }
 
-class PressureSolverTest : public ::testing::TestWithParam<PressureSolver> {};
+class FluidPressureSolverTest : public ::testing::TestWithParam<PressureSolver> {};
 
-TEST_P(PressureSolverTest, TwoPhaseStillWaterIsHydrostaticAtDensityRatio1000) {
+TEST_P(FluidPressureSolverTest, TwoPhaseStillWaterIsHydrostaticAtDensityRatio1000) {
     const int n = 16;
     MacGrid grid(n, n, n, 1.0 / n);
     PhaseOptions phases;
@@ -93,7 +93,7 @@ TEST_P(PressureSolverTest, TwoPhaseStillWaterIsHydrostaticAtDensityRatio1000) {
     EXPECT_LT(max_error, 1e-7 * scale) << "max hydrostatic error " << max_error << " Pa";
 }
 
-TEST_P(PressureSolverTest, FreeSurfaceStillWaterIsHydrostatic) {
+TEST_P(FluidPressureSolverTest, FreeSurfaceStillWaterIsHydrostatic) {
     const int n = 16;
     MacGrid grid(n, n, n, 1.0 / n);
     PhaseOptions phases;
@@ -126,7 +126,7 @@ TEST_P(PressureSolverTest, FreeSurfaceStillWaterIsHydrostatic) {
     EXPECT_LT(max_error, 1e-7 * phases.rho_liquid * GRAVITY * h) << max_error << " Pa";
 }
 
-TEST_P(PressureSolverTest, FlatInterfaceWithConstantCurvatureJumpsBySigmaKappa) {
+TEST_P(FluidPressureSolverTest, FlatInterfaceWithConstantCurvatureJumpsBySigmaKappa) {
     const int n = 16;
     MacGrid grid(n, n, n, 1.0 / n);
     PhaseOptions phases;
@@ -164,7 +164,7 @@ TEST_P(PressureSolverTest, FlatInterfaceWithConstantCurvatureJumpsBySigmaKappa) 
     }
 }
 
-TEST_P(PressureSolverTest, ProjectedVelocityIsDivergenceFreeAroundAGasBubble) {
+TEST_P(FluidPressureSolverTest, ProjectedVelocityIsDivergenceFreeAroundAGasBubble) {
     const int n = 24;
     MacGrid grid(n, n, n, 1.0 / n);
     PhaseOptions phases;
@@ -204,7 +204,7 @@ TEST_P(PressureSolverTest, ProjectedVelocityIsDivergenceFreeAroundAGasBubble) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllBackends, PressureSolverTest,
+INSTANTIATE_TEST_SUITE_P(AllBackends, FluidPressureSolverTest,
                          ::testing::Values(PressureSolver::mic0_pcg, PressureSolver::multigrid_pcg,
                                            PressureSolver::eigen_ic_cg),
                          [](const ::testing::TestParamInfo<PressureSolver>& param_info) {
@@ -219,7 +219,7 @@ INSTANTIATE_TEST_SUITE_P(AllBackends, PressureSolverTest,
                              return std::string("unknown");
                          });
 
-TEST(PressureBackends, AllBackendsAgreeOnABubbleSystem) {
+TEST(FluidPressureBackends, AllBackendsAgreeOnABubbleSystem) {
     const int n = 20;
     MacGrid grid(n, n, n, 0.05);
     PhaseOptions phases;
@@ -256,7 +256,7 @@ TEST(PressureBackends, AllBackendsAgreeOnABubbleSystem) {
     EXPECT_LT(diff_eigen, 1e-6 * scale);
 }
 
-TEST(PressureOptions, ValidateNamesTheField) {
+TEST(FluidPressureOptions, ValidateNamesTheField) {
     PressureOptions options;
     options.min_liquid_fraction = 0.0;
     try {

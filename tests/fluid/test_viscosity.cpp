@@ -85,7 +85,7 @@ PoiseuilleErrors poiseuille_errors(int cells_across) {
     return errors;
 }
 
-TEST(Viscosity, PoiseuilleFlowConvergesToTheParabolaAtSecondOrder) {
+TEST(FluidViscosity, PoiseuilleFlowConvergesToTheParabolaAtSecondOrder) {
     const PoiseuilleErrors e8 = poiseuille_errors(8);
     const PoiseuilleErrors e16 = poiseuille_errors(16);
     const PoiseuilleErrors e32 = poiseuille_errors(32);
@@ -103,7 +103,7 @@ TEST(Viscosity, PoiseuilleFlowConvergesToTheParabolaAtSecondOrder) {
     EXPECT_LT(e32.pressure_gradient, 5e-4);
 }
 
-TEST(Viscosity, RestStaysAtRestWithVariableViscosity) {
+TEST(FluidViscosity, RestStaysAtRestWithVariableViscosity) {
     MacGrid grid(10, 10, 10, 0.1);
     InterfaceInput interface(grid);
     for (int k = 0; k < 10; ++k) {
@@ -124,7 +124,7 @@ TEST(Viscosity, RestStaysAtRestWithVariableViscosity) {
     }
 }
 
-TEST(Viscosity, TaylorGreenModeIsAnExactDiscreteEigenmode) {
+TEST(FluidViscosity, TaylorGreenModeIsAnExactDiscreteEigenmode) {
     // u = sin(πx) cos(πy), v = −cos(πx) sin(πy) on the free-slip unit square is discretely
     // divergence-free on the MAC grid and an eigenvector of the discrete ∇·(2με) with eigenvalue
     // −2μ k², k² = (2 sin(π dx/2) / dx)². One backward-Euler step scales it by 1/(1 + 2Δtνk²).
