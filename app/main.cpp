@@ -1,0 +1,148 @@
+/// The `meniscus` command line. Exit codes: 0 success, 1 internal failure, 2 bad input
+/// (arguments, scene, mesh file), 130 interrupted by Ctrl-C (all written files complete).
+
+#include "app/json_fields.h"
+#include "app/run.h"
+#include "app/scene.h"
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace meniscus::app;
+
+constexpr int EXIT_OK = 0;
+constexpr int EXIT_INTERNAL = 1;
+constexpr int EXIT_BAD_INPUT = 2;
+constexpr int EXIT_INTERRUPTED = 130;
+
+std::atomic<bool> g_stop_requested{false};
+
+extern "C" void on_interrupt(int) {
+    g_stop_requested.store(true);
+    std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends the process at once
+}
+
+const char* USAGE =
+    "usage: meniscus <command> [options]\n"
+    "\n"
+    "commands:\n"
+    "  run SCENE.json [--out DIR] [--frames N] [--quiet]\n"
+    "        run a scene, writing per frame surface_NNNN.ply, fields_NNNN.vdb and a line of\n"
+    "        stats.jsonl into DIR (default: out/). --frames N overrides the scene's frame count\n"
+    "        (keeping its time per frame). Ctrl-C stops after the current step; every file\n"
+    "        already written is complete.\n"
+    "  scene-reference\n"
+    "        print every scene key with its type, default, unit and meaning (Markdown)\n"
+    "\n"
+    "options:\n"
+    "  --help     this text\n"
+    "  --version  the version\n"
+    "\n"
+    "exit codes: 0 success, 1 internal failure, 2 bad input, 130 interrupted\n";
+
+class UsageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+int parse_positive_int(const std::string& flag, const std::string& text) {
+    try {
+        size_t used = 0;
+        const long v = std::stol(text, &used);
+        if (used != text.size() || v <= 0 || v > 1000000)
+            throw std::out_of_range(text);
+        return static_cast<int>(v);
+    } catch (const std::exception&) {
+        throw UsageError(flag + ": expected a whole number from 1 to 1000000, got '" + text + "'");
+    }
+}
+
+int command_run(const std::vector<std::string>& args) {
+    std::string scene_path;
+    RunOptions options;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        const auto value = [&]() -> const std::string& {
+            if (i + 1 >= args.size())
+                throw UsageError(a + ": missing value");
+            return args[++i];
+        };
+        if (a == "--out")
+            options.out_dir = value();
+        else if (a == "--frames")
+            options.frames = parse_positive_int(a, value());
+        else if (a == "--quiet")
+            options.quiet = true;
+        else if (!a.empty() && a[0] == '-')
+            throw UsageError("run: unknown option " + a);
+        else if (scene_path.empty())
+            scene_path = a;
+        else
+            throw UsageError("run: more than one scene file given ('" + scene_path + "', '" + a +
+                             "')");
+    }
+    if (scene_path.empty())
+        throw UsageError("run: no scene file given");
+    const Scene scene = load_scene(scene_path);
+    std::signal(SIGINT, on_interrupt);
+    const RunResult result = run_scene(scene, options, g_stop_requested);
+    if (result.interrupted) {
+        std::fprintf(stderr, "meniscus: interrupted at t = %g s; frames 0..%d in %s are complete\n",
+                     result.simulated_time, result.frames_written - 1, options.out_dir.c_str());
+        return EXIT_INTERRUPTED;
+    }
+    if (!options.quiet)
+        std::fprintf(stderr, "meniscus: wrote %d frames (%lld steps) to %s\n",
+                     result.frames_written, result.steps, options.out_dir.c_str());
+    return EXIT_OK;
+}
+
+int dispatch(int argc, char** argv) {
+    const std::vector<std::string> args(argv + 1, argv + argc);
+    if (args.empty())
+        throw UsageError("no command given");
+    const std::string& command = args[0];
+    if (command == "--help" || command == "-h" || command == "help") {
+        std::fputs(USAGE, stdout);
+        return EXIT_OK;
+    }
+    if (command == "--version") {
+        std::printf("meniscus %s\n", MENISCUS_VERSION);
+        return EXIT_OK;
+    }
+    if (command == "run")
+        return command_run({args.begin() + 1, args.end()});
+    if (command == "scene-reference") {
+        std::fputs(scene_reference_markdown().c_str(), stdout);
+        return EXIT_OK;
+    }
+    throw UsageError("unknown command '" + command + "'");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        return dispatch(argc, argv);
+    } catch (const UsageError& e) {
+        std::fprintf(stderr, "meniscus: %s\n\n%s", e.what(), USAGE);
+        return EXIT_BAD_INPUT;
+    } catch (const SceneError& e) {
+        std::fprintf(stderr, "meniscus: bad scene: %s\n", e.what());
+        return EXIT_BAD_INPUT;
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "meniscus: bad input: %s\n", e.what());
+        return EXIT_BAD_INPUT;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "meniscus: internal failure: %s\n", e.what());
+        return EXIT_INTERNAL;
+    }
+}

@@ -1,0 +1,42 @@
+#pragma once
+/// \file Running a scene: initial surface, time stepping, per-frame output.
+
+#include "app/scene.h"
+#include "tracker/mesh.h"
+
+#include <atomic>
+#include <stdexcept>
+#include <string>
+
+namespace meniscus::app {
+
+/// Bad user input outside the scene JSON itself (e.g. a broken mesh file): exit code 2.
+class InputError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+/// Command-line choices of `meniscus run`.
+struct RunOptions {
+    std::string out_dir = "out";
+    int frames = 0;  ///< > 0 overrides /time/frames, keeping the time per frame
+    bool quiet = false;
+};
+
+/// How a run ended.
+struct RunResult {
+    int frames_written = 0;  ///< including frame 0
+    bool interrupted = false;
+    double simulated_time = 0.0;
+    long long steps = 0;
+};
+
+/// Builds the initial surface of a scene (meshing its shape or loading and validating its mesh
+/// file). Throws InputError naming the file and the failed check for a bad mesh file.
+tracker::SurfaceMesh build_initial_surface(const Scene& scene, std::string* report = nullptr);
+
+/// Runs the scene, writing frames into options.out_dir. Stops cleanly at the next step boundary
+/// once `stop` becomes true (every file already written is complete).
+RunResult run_scene(const Scene& scene, const RunOptions& options, const std::atomic<bool>& stop);
+
+}  // namespace meniscus::app

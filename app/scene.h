@@ -1,0 +1,64 @@
+#pragma once
+/// \file Scene files: JSON (SI units) read into options structs. Every key has its default in
+/// the struct below and nowhere else; `meniscus scene-reference` prints them all.
+
+#include "tracker/implicit_shape.h"
+
+#include <Eigen/Core>
+
+#include <string>
+
+namespace meniscus::app {
+
+/// Where the initial surface comes from: an implicit shape tree or a mesh file.
+struct SurfaceOptions {
+    double edge_length = 0.02;  ///< requested mean edge length ξ of the generated mesh (m)
+    std::string mesh_file;      ///< OBJ/PLY path, relative to the scene file (instead of shape)
+    int remesh_iterations = 8;  ///< isotropic remeshing passes when meshing a shape
+};
+
+/// The motion that drives the surface until the fluid solver lands (paper §4 test modes).
+struct FlowOptions {
+    std::string type = "enright";  ///< "enright" (paper §4.3) or "none" (surface stays still)
+    double period = 3.0;           ///< Enright period T: velocity modulated by sin(2πt/T) (s)
+};
+
+/// Simulated time and frames.
+struct TimeOptions {
+    double end = 3.0;  ///< simulated end time (s)
+    int frames = 30;   ///< frames written after the initial one, evenly spaced in time
+    double dt = 0.01;  ///< maximum time step (s); steps are shortened to land on frame times
+};
+
+/// What is written every frame.
+struct OutputOptions {
+    bool ply = true;                 ///< surface_NNNN.ply (binary little-endian)
+    bool ply_velocity = true;        ///< per-vertex velocity (vx, vy, vz) in the PLY
+    bool obj = false;                ///< surface_NNNN.obj as well
+    bool vdb = true;                 ///< fields_NNNN.vdb with `surface` and `density`
+    double voxel_size = 0.0;         ///< VDB voxel size (m); 0 = half the surface edge length
+    double half_width_voxels = 3.0;  ///< narrow-band half width of `surface` (voxels)
+};
+
+/// A whole scene.
+struct Scene {
+    std::string name = "scene";
+    std::string description;
+    SurfaceOptions surface;
+    tracker::ShapePtr shape;  ///< set when the scene gives /surface/shape
+    FlowOptions flow;
+    TimeOptions time;
+    OutputOptions output;
+    std::string source_path;  ///< the file it was read from
+};
+
+/// Reads and validates a scene file. Throws SceneError ("<file>: <json path>: <problem>") for
+/// unreadable files, JSON syntax errors, unknown keys, wrong types and out-of-range values.
+Scene load_scene(const std::string& path);
+/// Parses a scene from JSON text; `source` names it in errors, `base_dir` resolves mesh_file.
+Scene parse_scene(const std::string& json_text, const std::string& source,
+                  const std::string& base_dir);
+/// Markdown reference of every scene key: type, default, unit, meaning.
+std::string scene_reference_markdown();
+
+}  // namespace meniscus::app

@@ -1,0 +1,91 @@
+#include "coupling/vdb_output.h"
+
+#include "common/atomic_file.h"
+
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetUtil.h>
+#include <openvdb/tools/MeshToVolume.h>
+
+#include <cmath>
+#include <mutex>
+#include <stdexcept>
+#include <vector>
+
+namespace meniscus::coupling {
+
+namespace {
+
+void initialize_openvdb_once() {
+    static std::once_flag flag;
+    std::call_once(flag, [] { openvdb::initialize(); });
+}
+
+}  // namespace
+
+void VdbOutputOptions::validate() const {
+    if (!(voxel_size > 0.0) || !std::isfinite(voxel_size))
+        throw std::invalid_argument("voxel_size: expected a number > 0");
+    if (!(half_width_voxels >= 1.0) || !std::isfinite(half_width_voxels))
+        throw std::invalid_argument("half_width_voxels: expected a number >= 1");
+}
+
+VdbOutputInfo write_surface_vdb(const std::string& path, const tracker::SurfaceMesh& mesh,
+                                const VdbOutputOptions& options) {
+    options.validate();
+    initialize_openvdb_once();
+
+    std::vector<openvdb::Vec3s> points;
+    std::vector<openvdb::Vec3I> triangles;
+    std::vector<int> dense(static_cast<size_t>(mesh.num_vertices()), tracker::INVALID_INDEX);
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        if (!mesh.vertex_alive(vi))
+            continue;
+        dense[static_cast<size_t>(vi)] = static_cast<int>(points.size());
+        const tracker::Vec3& p = mesh.position(vi);
+        points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                            static_cast<float>(p.z()));
+    }
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti))
+            continue;
+        const tracker::Triangle& t = mesh.triangle(ti);
+        // meshToLevelSet finds the inside by flood fill, so the winding does not set the sign.
+        triangles.emplace_back(static_cast<unsigned>(dense[static_cast<size_t>(t[0])]),
+                               static_cast<unsigned>(dense[static_cast<size_t>(t[1])]),
+                               static_cast<unsigned>(dense[static_cast<size_t>(t[2])]));
+    }
+    if (triangles.empty())
+        throw std::invalid_argument("write_surface_vdb: the mesh has no triangles");
+
+    const auto transform = openvdb::math::Transform::createLinearTransform(options.voxel_size);
+    openvdb::FloatGrid::Ptr surface = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(
+        *transform, points, triangles, static_cast<float>(options.half_width_voxels));
+    surface->setName("surface");
+    surface->setGridClass(openvdb::GRID_LEVEL_SET);
+
+    openvdb::GridPtrVec grids{surface};
+    VdbOutputInfo info;
+    info.surface_active_voxels = static_cast<long long>(surface->activeVoxelCount());
+    if (options.density) {
+        openvdb::FloatGrid::Ptr density = surface->deepCopy();
+        // Inside the inner half band the fog ramps from 0 at the surface to 1 at the band edge.
+        openvdb::tools::sdfToFogVolume(*density);
+        density->setName("density");
+        info.density_active_voxels = static_cast<long long>(density->activeVoxelCount());
+        grids.push_back(density);
+    }
+
+    const std::string tmp = temporary_path_for(path);
+    try {
+        openvdb::io::File file(tmp);
+        file.write(grids);
+        file.close();
+    } catch (const openvdb::Exception& e) {
+        std::remove(tmp.c_str());
+        throw std::runtime_error(path + ": cannot write VDB: " + e.what());
+    }
+    commit_temporary(path);
+    return info;
+}
+
+}  // namespace meniscus::coupling

@@ -1,0 +1,231 @@
+// Runs the built `meniscus` binary and checks exit codes and messages of each error path.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+    int exit_code = -1;
+    std::string output;  // stdout and stderr together
+};
+
+Outcome run_meniscus(const std::string& args) {
+    const std::string command = std::string(MENISCUS_BINARY) + " " + args + " 2>&1";
+    Outcome o;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe)
+        return o;
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, pipe)) > 0)
+        o.output.append(buf, n);
+    const int status = pclose(pipe);
+    o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return o;
+}
+
+class CliTest : public testing::Test {
+protected:
+    void SetUp() override {
+        m_dir = fs::temp_directory_path() /
+                ("meniscus_cli_" +
+                 std::string(testing::UnitTest::GetInstance()->current_test_info()->name()));
+        fs::remove_all(m_dir);
+        fs::create_directories(m_dir);
+    }
+    void TearDown() override { fs::remove_all(m_dir); }
+    std::string write(const std::string& name, const std::string& text) {
+        const fs::path p = m_dir / name;
+        std::ofstream(p) << text;
+        return p.string();
+    }
+    fs::path m_dir;
+};
+
+const char* SMALL_SCENE = R"({
+  "surface": {"edge_length": 0.05, "shape": {"type": "sphere", "center": [0.5, 0.5, 0.5], "radius": 0.15}},
+  "time": {"end": 0.04, "frames": 2, "dt": 0.01},
+  "output": {"vdb": true, "obj": true}
+})";
+
+const char* OCTAHEDRON_OBJ =
+    "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n"
+    "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
+
+TEST_F(CliTest, HelpAndVersionSucceed) {
+    const Outcome help = run_meniscus("--help");
+    EXPECT_EQ(help.exit_code, 0);
+    EXPECT_NE(help.output.find("usage: meniscus"), std::string::npos);
+    const Outcome version = run_meniscus("--version");
+    EXPECT_EQ(version.exit_code, 0);
+    EXPECT_NE(version.output.find("meniscus "), std::string::npos);
+}
+
+TEST_F(CliTest, NoCommandIsBadInput) {
+    const Outcome o = run_meniscus("");
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("no command given"), std::string::npos);
+}
+
+TEST_F(CliTest, UnknownCommandIsBadInput) {
+    const Outcome o = run_meniscus("frobnicate");
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("unknown command 'frobnicate'"), std::string::npos);
+}
+
+TEST_F(CliTest, RunWithoutSceneIsBadInput) {
+    const Outcome o = run_meniscus("run");
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("no scene file given"), std::string::npos);
+}
+
+TEST_F(CliTest, UnknownOptionIsBadInput) {
+    const Outcome o = run_meniscus("run x.json --fast");
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("unknown option --fast"), std::string::npos);
+}
+
+TEST_F(CliTest, BadFramesValueIsBadInput) {
+    const Outcome o = run_meniscus("run x.json --frames zero");
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("--frames: expected a whole number"), std::string::npos);
+}
+
+TEST_F(CliTest, MissingSceneFileNamesTheFile) {
+    const Outcome o = run_meniscus((m_dir / "nope.json").string());
+    EXPECT_EQ(o.exit_code, 2);  // unknown command (a path is not a command)
+    const Outcome r = run_meniscus("run " + (m_dir / "nope.json").string());
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.output.find("nope.json: cannot open the scene file"), std::string::npos);
+}
+
+TEST_F(CliTest, JsonSyntaxErrorIsBadInput) {
+    const std::string scene = write("broken.json", "{\"time\": {\"end\": 1,}");
+    const Outcome o = run_meniscus("run " + scene);
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("broken.json: invalid JSON"), std::string::npos);
+}
+
+TEST_F(CliTest, UnknownKeyNamesItsJsonPath) {
+    const std::string scene =
+        write("typo.json", R"({"surface": {"shape": {"type": "sphere"}, "edge_lenght": 0.1}})");
+    const Outcome o = run_meniscus("run " + scene);
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("/surface/edge_lenght: unknown key"), std::string::npos) << o.output;
+}
+
+TEST_F(CliTest, OutOfRangeValueNamesItsJsonPath) {
+    const std::string scene =
+        write("range.json", R"({"surface": {"shape": {"type": "sphere"}}, "time": {"dt": -1}})");
+    const Outcome o = run_meniscus("run " + scene);
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("/time/dt: expected a number > 0, got -1"), std::string::npos)
+        << o.output;
+}
+
+TEST_F(CliTest, OpenMeshFileIsRejectedWithTheCheckThatFailed) {
+    write("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n");
+    const std::string scene = write("s.json", R"({"surface": {"mesh_file": "open.obj"}})");
+    const Outcome o = run_meniscus("run " + scene + " --out " + (m_dir / "out").string());
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("open.obj: not a valid closed surface"), std::string::npos) << o.output;
+    EXPECT_NE(o.output.find("boundary edge"), std::string::npos) << o.output;
+}
+
+TEST_F(CliTest, InconsistentlyOrientedMeshFileIsRejected) {
+    std::string obj = OCTAHEDRON_OBJ;
+    obj.replace(obj.find("f 1 3 5"), 7, "f 1 5 3");
+    write("flipped.obj", obj);
+    const std::string scene = write("s.json", R"({"surface": {"mesh_file": "flipped.obj"}})");
+    const Outcome o = run_meniscus("run " + scene + " --out " + (m_dir / "out").string());
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("inconsistent orientation"), std::string::npos) << o.output;
+}
+
+TEST_F(CliTest, BadIndexInMeshFileNamesTheLine) {
+    write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n");
+    const std::string scene = write("s.json", R"({"surface": {"mesh_file": "bad.obj"}})");
+    const Outcome o = run_meniscus("run " + scene + " --out " + (m_dir / "out").string());
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("bad.obj: line 4: malformed face index 'x'"), std::string::npos)
+        << o.output;
+}
+
+TEST_F(CliTest, DuplicateTriangleInMeshFileIsRejected) {
+    write("dup.obj", std::string(OCTAHEDRON_OBJ) + "f 1 3 5\nf 1 5 3\n");
+    const std::string scene = write("s.json", R"({"surface": {"mesh_file": "dup.obj"}})");
+    const Outcome o = run_meniscus("run " + scene + " --out " + (m_dir / "out").string());
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("duplicate triangle"), std::string::npos) << o.output;
+}
+
+TEST_F(CliTest, RunWritesEveryFrameAndStats) {
+    const std::string scene = write("small.json", SMALL_SCENE);
+    const fs::path out = m_dir / "out";
+    const Outcome o = run_meniscus("run " + scene + " --out " + out.string() + " --quiet");
+    ASSERT_EQ(o.exit_code, 0) << o.output;
+    for (const char* f : {"surface_0000.ply", "surface_0002.ply", "surface_0002.obj",
+                          "fields_0000.vdb", "fields_0002.vdb", "stats.jsonl"})
+        EXPECT_TRUE(fs::exists(out / f)) << f;
+    EXPECT_FALSE(fs::exists(out / "surface_0003.ply"));
+    std::ifstream stats(out / "stats.jsonl");
+    int lines = 0;
+    for (std::string line; std::getline(stats, line);)
+        ++lines;
+    EXPECT_EQ(lines, 3);
+    for (const auto& entry : fs::directory_iterator(out))
+        EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
+}
+
+TEST_F(CliTest, FramesOptionOverridesTheSceneKeepingTimePerFrame) {
+    const std::string scene = write("small.json", SMALL_SCENE);
+    const fs::path out = m_dir / "out";
+    const Outcome o =
+        run_meniscus("run " + scene + " --out " + out.string() + " --quiet --frames 1");
+    ASSERT_EQ(o.exit_code, 0) << o.output;
+    EXPECT_TRUE(fs::exists(out / "surface_0001.ply"));
+    EXPECT_FALSE(fs::exists(out / "surface_0002.ply"));
+}
+
+TEST_F(CliTest, InterruptFinishesCleanly) {
+    // A long run interrupted with SIGINT exits 130 and leaves only complete files.
+    const std::string scene = write("long.json", R"({
+      "surface": {"edge_length": 0.02, "shape": {"type": "sphere", "center": [0.35, 0.35, 0.35], "radius": 0.15}},
+      "time": {"end": 3000, "frames": 1000, "dt": 0.01}, "output": {"vdb": false}})");
+    const fs::path out = m_dir / "out";
+    const std::string command = "timeout --preserve-status -s INT 2 " +
+                                std::string(MENISCUS_BINARY) + " run " + scene + " --out " +
+                                out.string() + " --quiet 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string output;
+    char buf[1024];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, pipe)) > 0)
+        output.append(buf, n);
+    const int status = pclose(pipe);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 130) << output;
+    EXPECT_NE(output.find("interrupted at t ="), std::string::npos) << output;
+    EXPECT_TRUE(fs::exists(out / "surface_0000.ply"));
+    for (const auto& entry : fs::directory_iterator(out))
+        EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
+}
+
+TEST_F(CliTest, SceneReferenceListsEveryKey) {
+    const Outcome o = run_meniscus("scene-reference");
+    EXPECT_EQ(o.exit_code, 0);
+    for (const char* key : {"`edge_length`", "`mesh_file`", "`dt`", "`voxel_size`",
+                            "`major_radius`", "`handle_radius`", "### `/output`"})
+        EXPECT_NE(o.output.find(key), std::string::npos) << key;
+}
+
+}  // namespace

@@ -1,0 +1,106 @@
+#include "app/json_fields.h"
+#include "app/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace meniscus::app {
+namespace {
+
+std::string error_of(const std::string& json) {
+    try {
+        parse_scene(json, "test.json", ".");
+    } catch (const SceneError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(Scene, EveryShippedSceneParses) {
+    int count = 0;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(
+             std::string(MENISCUS_SOURCE_DIR) + "/scenes")) {
+        if (entry.path().extension() != ".json")
+            continue;
+        ++count;
+        EXPECT_NO_THROW(load_scene(entry.path().string())) << entry.path();
+    }
+    EXPECT_GT(count, 0);
+}
+
+TEST(Scene, DefaultsComeFromTheStructs) {
+    const Scene s = parse_scene(R"({"surface": {"shape": {"type": "sphere"}}})", "t.json", ".");
+    const Scene d;
+    EXPECT_EQ(s.time.dt, d.time.dt);
+    EXPECT_EQ(s.time.frames, d.time.frames);
+    EXPECT_EQ(s.output.half_width_voxels, d.output.half_width_voxels);
+    ASSERT_TRUE(s.shape);
+    EXPECT_DOUBLE_EQ(s.shape->value({0, 0, 0}), -0.2);  // default sphere radius 0.2
+}
+
+TEST(Scene, ErrorsNameTheJsonPath) {
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "tracker": {}})")
+                  .find("test.json: /tracker: unknown key"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere", "radius": "big"}}})")
+                  .find("/surface/shape/radius: expected a number > 0, got a string"),
+              std::string::npos);
+    EXPECT_NE(
+        error_of(
+            R"({"surface": {"shape": {"type": "union", "shapes": [{"type": "sphere"}, {"type": "cone"}]}}})")
+            .find("/surface/shape/shapes/1/type: expected one of"),
+        std::string::npos);
+    EXPECT_NE(
+        error_of(
+            R"({"surface": {"shape": {"type": "torus", "major_radius": 0.1, "minor_radius": 0.2}}})")
+            .find("/surface/shape: torus major_radius - minor_radius"),
+        std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "box", "min": [0, 0]}}})")
+                  .find("/surface/shape/min: expected an array of 3 numbers"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {}})").find("/surface: give either `shape` or `mesh_file`"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"time": {"frames": 2.5}, "surface": {"shape": {"type": "sphere"}}})")
+                  .find("/time/frames: expected an integer"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"flow": {"type": "wind"}, "surface": {"shape": {"type": "sphere"}}})")
+                  .find("/flow/type: expected one of \"enright\", \"none\", got \"wind\""),
+              std::string::npos);
+    EXPECT_NE(error_of("[1, 2]").find("/: expected an object"), std::string::npos);
+}
+
+TEST(Scene, MeshFileIsRelativeToTheScene) {
+    const Scene s = parse_scene(R"({"surface": {"mesh_file": "m.obj"}})", "dir/s.json", "dir");
+    EXPECT_EQ(s.surface.mesh_file, "dir/m.obj");
+}
+
+TEST(Range, DescribesAndChecks) {
+    EXPECT_EQ(Range::positive().describe(), "> 0");
+    EXPECT_EQ(Range::at_least(1).describe(), ">= 1");
+    EXPECT_EQ(Range::between(0, 1).describe(), "in [0, 1]");
+    EXPECT_FALSE(Range::positive().contains(0.0));
+    EXPECT_TRUE(Range::non_negative().contains(0.0));
+    EXPECT_FALSE(Range::any().contains(std::numeric_limits<double>::quiet_NaN()));
+}
+
+}  // namespace
+}  // namespace meniscus::app
+
+namespace meniscus::app {
+namespace {
+
+TEST(Scene, ShippedReferenceIsUpToDate) {
+    std::ifstream in(std::string(MENISCUS_SOURCE_DIR) + "/scenes/README.md");
+    ASSERT_TRUE(in) << "scenes/README.md is missing";
+    std::ostringstream text;
+    text << in.rdbuf();
+    EXPECT_EQ(text.str(), scene_reference_markdown())
+        << "regenerate with: build/app/meniscus scene-reference > scenes/README.md";
+}
+
+}  // namespace
+}  // namespace meniscus::app
