@@ -1,12 +1,14 @@
 #include "fluid/viscosity.h"
 
-#include <Eigen/IterativeLinearSolvers>
-#include <Eigen/SparseCore>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <array>
-#include <cstdint>
+#include <cmath>
 #include <stdexcept>
 #include <vector>
+
+#include "fluid/poisson_matrix.h"
 
 namespace meniscus::fluid {
 
@@ -14,259 +16,305 @@ namespace {
 
 /// Weight of a shear strain-rate term: 2 μ ε_ab² = ½ μ (∂_b u_a + ∂_a u_b)².
 constexpr double SHEAR_WEIGHT = 0.5;
-constexpr int MAX_TERM_ENTRIES = 4;
 constexpr double HALF = 0.5;
+/// A no-slip wall mirrors the tangential velocity: the one-sided derivative doubles.
+constexpr double MIRROR_FACTOR = 2.0;
 
-/// A linear combination Σ coeff·(face velocity) that enters the energy squared.
-struct StrainTerm {
-    int count = 0;
-    std::array<int, MAX_TERM_ENTRIES> axis{};
-    std::array<std::size_t, MAX_TERM_ENTRIES> face{};
-    std::array<double, MAX_TERM_ENTRIES> coeff{};
+using Index3 = std::array<int, 3>;
 
-    void add(int a, std::size_t f, double c) {
-        axis[count] = a;
-        face[count] = f;
-        coeff[count] = c;
-        ++count;
-    }
-};
-
-class ViscousSystem {
+/// Matrix-free operator of the backward-Euler viscous step on all face velocities, stored as one
+/// flat vector [u | v | w] (each block in its Array3 layout). With the energy of viscosity.h,
+///   A x = ρ_f x + K x,  K x = Dᵀ (2Δt W) D x,
+/// where D maps face velocities to strain rates (cell centres and edges) and W holds μ_c or
+/// ½ μ_e (× the dual-cell fraction inside the box). K x is evaluated in three TBB-parallel
+/// passes: diagonal stresses at cells, shear stresses on edges, their divergence on faces.
+class ViscousOperator {
 public:
-    ViscousSystem(const MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,
-                  FluidMode mode, const WallOptions& walls, double dt)
-        : m_grid(grid),
-          m_phi(interface.phi),
-          m_phases(phases),
-          m_mode(mode),
-          m_walls(walls),
-          m_dt(dt) {
-        number_unknowns();
-        cell_viscosity();
-    }
-
-    std::int64_t unknown_count() const { return m_count; }
-
-    void assemble(Eigen::SparseMatrix<double>& matrix, Eigen::VectorXd& rhs,
-                  Eigen::VectorXd& guess) {
-        rhs.setZero(m_count);
-        guess.setZero(m_count);
-        std::vector<Eigen::Triplet<double>> triplets;
-        mass_terms(triplets, rhs, guess);
-        diagonal_strain_terms(triplets, rhs);
-        shear_strain_terms(triplets, rhs);
-        matrix.resize(m_count, m_count);
-        matrix.setFromTriplets(triplets.begin(), triplets.end());
-    }
-
-    void scatter(const Eigen::VectorXd& solution, MacGrid& grid) const {
+    ViscousOperator(const MacGrid& grid, const Array3<double>& phi, const PhaseOptions& phases,
+                    FluidMode mode, const WallOptions& walls, double dt)
+        : m_n{grid.nx(), grid.ny(), grid.nz()}, m_dx(grid.dx()), m_dt(dt) {
+        std::size_t offset = 0;
         for (int a = 0; a < 3; ++a) {
-            Array3<double>& faces = grid.velocity(a);
-            for (std::size_t f = 0; f < faces.size(); ++f) {
-                if (m_unknown[a][f] >= 0) {
-                    faces[f] = solution[m_unknown[a][f]];
-                }
-            }
+            m_face_dims[a] = m_n;
+            ++m_face_dims[a][a];
+            m_offset[a] = offset;
+            offset += grid.velocity(a).size();
+            Index3 edge_dims = {m_n[0] + 1, m_n[1] + 1, m_n[2] + 1};
+            --edge_dims[a];  // edges parallel to axis a
+            m_edge_weight[a].resize(edge_dims[0], edge_dims[1], edge_dims[2], 0.0);
+            m_shear_stress[a].resize(edge_dims[0], edge_dims[1], edge_dims[2], 0.0);
+            m_normal_stress[a].resize(m_n[0], m_n[1], m_n[2], 0.0);
         }
+        m_size = offset;
+        const double mu_gas = mode == FluidMode::two_phase ? phases.mu_gas : 0.0;
+        m_mu.resize(m_n[0], m_n[1], m_n[2]);
+        for (std::size_t c = 0; c < m_mu.size(); ++c) {
+            m_mu[c] = is_liquid(phi[c]) ? phases.mu_liquid : mu_gas;
+        }
+        set_edge_weights(walls);
+        set_faces(grid, phi, phases, mode);
+    }
+
+    std::size_t size() const { return m_size; }
+    const std::vector<char>& unknown() const { return m_unknown; }
+    const std::vector<double>& density() const { return m_density; }
+
+    /// Flat vector [u | v | w] of the grid's face velocities.
+    std::vector<double> gather(const MacGrid& grid) const {
+        std::vector<double> x(m_size);
+        for (int a = 0; a < 3; ++a) {
+            const std::vector<double>& faces = grid.velocity(a).storage();
+            std::copy(faces.begin(), faces.end(), x.begin() + m_offset[a]);
+        }
+        return x;
+    }
+
+    void scatter(const std::vector<double>& x, MacGrid& grid) const {
+        for (int a = 0; a < 3; ++a) {
+            std::vector<double>& faces = grid.velocity(a).storage();
+            std::copy(x.begin() + m_offset[a], x.begin() + m_offset[a] + faces.size(),
+                      faces.begin());
+        }
+    }
+
+    /// y = K x on every interior face (0 on wall-normal faces).
+    void stiffness(const std::vector<double>& x, std::vector<double>& y) const {
+        y.assign(m_size, 0.0);
+        normal_stresses(x);
+        shear_stresses(x);
+        stress_divergence(y);
+    }
+
+    /// y = (ρ + K) x restricted to the unknowns (x must vanish on fixed faces; y does too).
+    void apply(const std::vector<double>& x, std::vector<double>& y) const {
+        stiffness(x, y);
+        for (std::size_t f = 0; f < m_size; ++f) {
+            y[f] = m_unknown[f] ? y[f] + m_density[f] * x[f] : 0.0;
+        }
+    }
+
+    /// Diagonal of ρ + K on the unknowns (1 on fixed faces), for Jacobi preconditioning.
+    std::vector<double> diagonal() const {
+        std::vector<double> d(m_size, 1.0);
+        const double inv_dx2 = 1.0 / (m_dx * m_dx);
+        for (int a = 0; a < 3; ++a) {
+            for_each_face(a, [&](const Index3& f, std::size_t flat) {
+                if (!m_unknown[flat]) {
+                    return;
+                }
+                Index3 lo = f;
+                --lo[a];
+                double sum =
+                    m_density[flat] +
+                    2.0 * m_dt * (m_mu(lo[0], lo[1], lo[2]) + m_mu(f[0], f[1], f[2])) * inv_dx2;
+                for (int b = 0; b < 3; ++b) {
+                    if (b == a) {
+                        continue;
+                    }
+                    const Array3<double>& weight = m_edge_weight[3 - a - b];
+                    Index3 above = f;
+                    ++above[b];
+                    const double c_below = (f[b] == 0 ? MIRROR_FACTOR : 1.0);
+                    const double c_above = (above[b] == m_n[b] ? MIRROR_FACTOR : 1.0);
+                    sum += 2.0 * m_dt * inv_dx2 *
+                           (weight(f[0], f[1], f[2]) * c_below * c_below +
+                            weight(above[0], above[1], above[2]) * c_above * c_above);
+                }
+                d[flat] = sum;
+            });
+        }
+        return d;
     }
 
 private:
-    void number_unknowns() {
-        for (int a = 0; a < 3; ++a) {
-            const Array3<double>& faces = m_grid.velocity(a);
-            m_unknown[a].assign(faces.size(), -1);
-            const int n_axis = m_grid.cells(a);
-            for (int k = 0; k < faces.nk(); ++k) {
-                for (int j = 0; j < faces.nj(); ++j) {
-                    for (int i = 0; i < faces.ni(); ++i) {
-                        const std::array<int, 3> idx = {i, j, k};
-                        if (idx[a] == 0 || idx[a] == n_axis) {
-                            continue;
-                        }
-                        std::array<int, 3> lo = idx;
-                        --lo[a];
-                        const double phi_lo = m_phi(lo[0], lo[1], lo[2]);
-                        const double phi_hi = m_phi(i, j, k);
-                        if (m_mode == FluidMode::free_surface && !is_liquid(phi_lo) &&
-                            !is_liquid(phi_hi)) {
-                            continue;
-                        }
-                        m_unknown[a][faces.index(i, j, k)] = m_count++;
-                    }
-                }
-            }
-        }
+    /// Calls visit(face index, flat index in [u|v|w]) for every interior face of component a.
+    template <class Visit>
+    void for_each_face(int a, Visit&& visit) const {
+        const Index3& dims = m_face_dims[a];
+        tbb::parallel_for(tbb::blocked_range<int>(0, dims[2]),
+                          [&](const tbb::blocked_range<int>& r) {
+                              for (int k = r.begin(); k != r.end(); ++k) {
+                                  for (int j = 0; j < dims[1]; ++j) {
+                                      for (int i = 0; i < dims[0]; ++i) {
+                                          const Index3 f = {i, j, k};
+                                          if (f[a] == 0 || f[a] == m_n[a]) {
+                                              continue;
+                                          }
+                                          visit(f, face_flat(a, f));
+                                      }
+                                  }
+                              }
+                          });
     }
 
-    void cell_viscosity() {
-        const double mu_gas = m_mode == FluidMode::two_phase ? m_phases.mu_gas : 0.0;
-        m_mu.resize(m_grid.nx(), m_grid.ny(), m_grid.nz());
-        for (std::size_t c = 0; c < m_mu.size(); ++c) {
-            m_mu[c] = is_liquid(m_phi[c]) ? m_phases.mu_liquid : mu_gas;
-        }
+    std::size_t face_flat(int a, const Index3& f) const {
+        const Index3& d = m_face_dims[a];
+        return m_offset[a] + static_cast<std::size_t>(f[0]) +
+               static_cast<std::size_t>(d[0]) *
+                   (static_cast<std::size_t>(f[1]) + static_cast<std::size_t>(d[1]) * f[2]);
     }
 
-    void mass_terms(std::vector<Eigen::Triplet<double>>& triplets, Eigen::VectorXd& rhs,
-                    Eigen::VectorXd& guess) const {
-        for (int a = 0; a < 3; ++a) {
-            const Array3<double>& faces = m_grid.velocity(a);
-            for (int k = 0; k < faces.nk(); ++k) {
-                for (int j = 0; j < faces.nj(); ++j) {
-                    for (int i = 0; i < faces.ni(); ++i) {
-                        const std::size_t f = faces.index(i, j, k);
-                        const std::int64_t row = m_unknown[a][f];
-                        if (row < 0) {
-                            continue;
-                        }
-                        std::array<int, 3> lo = {i, j, k};
-                        --lo[a];
-                        const double theta =
-                            liquid_fraction(m_phi(lo[0], lo[1], lo[2]), m_phi(i, j, k));
-                        const double rho = face_density(theta, m_phases, m_mode);
-                        triplets.emplace_back(row, row, rho);
-                        rhs[row] += rho * faces[f];
-                        guess[row] = faces[f];
-                    }
-                }
-            }
-        }
-    }
-
-    /// Adds 2Δt·weight·(Σ c u)² to the quadratic form: matrix entries among unknowns, known
-    /// (fixed) face values moved to the right-hand side.
-    void add_term(const StrainTerm& term, double weight,
-                  std::vector<Eigen::Triplet<double>>& triplets, Eigen::VectorXd& rhs) const {
-        if (weight == 0.0) {
-            return;
-        }
-        const double scale = 2.0 * m_dt * weight;
-        for (int m = 0; m < term.count; ++m) {
-            const std::int64_t row = m_unknown[term.axis[m]][term.face[m]];
-            if (row < 0) {
-                continue;
-            }
-            for (int n = 0; n < term.count; ++n) {
-                const double value = scale * term.coeff[m] * term.coeff[n];
-                const std::int64_t col = m_unknown[term.axis[n]][term.face[n]];
-                if (col >= 0) {
-                    triplets.emplace_back(row, col, value);
-                } else {
-                    rhs[row] -= value * m_grid.velocity(term.axis[n])[term.face[n]];
-                }
-            }
-        }
-    }
-
-    void diagonal_strain_terms(std::vector<Eigen::Triplet<double>>& triplets,
-                               Eigen::VectorXd& rhs) const {
-        const double inv_dx = 1.0 / m_grid.dx();
-        for (int k = 0; k < m_grid.nz(); ++k) {
-            for (int j = 0; j < m_grid.ny(); ++j) {
-                for (int i = 0; i < m_grid.nx(); ++i) {
-                    const double mu = m_mu(i, j, k);
-                    for (int a = 0; a < 3; ++a) {
-                        const Array3<double>& faces = m_grid.velocity(a);
-                        std::array<int, 3> hi = {i, j, k};
-                        ++hi[a];
-                        StrainTerm term;
-                        term.add(a, faces.index(hi[0], hi[1], hi[2]), inv_dx);
-                        term.add(a, faces.index(i, j, k), -inv_dx);
-                        add_term(term, mu, triplets, rhs);
-                    }
-                }
-            }
-        }
-    }
-
-    /// Adds ∂(velocity component a)/∂x_b at edge `edge` (indices of the edge lattice) to `term`.
-    /// Returns false when the edge lies on a free-slip wall of axis b (term dropped).
-    bool add_derivative(int a, int b, const std::array<int, 3>& edge, StrainTerm& term) const {
-        const double inv_dx = 1.0 / m_grid.dx();
-        const Array3<double>& faces = m_grid.velocity(a);
-        const int n_b = m_grid.cells(b);
-        std::array<int, 3> hi = edge;  // face of component a just above the edge along b
-        std::array<int, 3> lo = edge;
-        --lo[b];
-        if (edge[b] == 0 || edge[b] == n_b) {
-            const int side = edge[b] == 0 ? 0 : 1;
-            if (m_walls.at(b, side) == WallType::free_slip) {
-                return false;
-            }
-            // No-slip: the ghost is minus the interior face, so ∂/∂x_b = ±2 u_interior / dx.
-            const std::array<int, 3>& inside = side == 0 ? hi : lo;
-            const double sign = side == 0 ? 1.0 : -1.0;
-            term.add(a, faces.index(inside[0], inside[1], inside[2]), sign * 2.0 * inv_dx);
-            return true;
-        }
-        term.add(a, faces.index(hi[0], hi[1], hi[2]), inv_dx);
-        term.add(a, faces.index(lo[0], lo[1], lo[2]), -inv_dx);
-        return true;
-    }
-
-    double edge_viscosity(const std::array<int, 3>& edge, int a, int b) const {
-        double sum = 0.0;
-        int count = 0;
-        for (int da = -1; da <= 0; ++da) {
-            for (int db = -1; db <= 0; ++db) {
-                std::array<int, 3> cell = edge;
-                cell[a] += da;
-                cell[b] += db;
-                if (m_mu.contains(cell[0], cell[1], cell[2])) {
-                    sum += m_mu(cell[0], cell[1], cell[2]);
-                    ++count;
-                }
-            }
-        }
-        return count > 0 ? sum / count : 0.0;
-    }
-
-    /// Fraction of an edge's dual cell inside the box: ½ per wall the edge lies on.
-    double edge_volume_fraction(const std::array<int, 3>& edge, int a, int b) const {
-        double fraction = 1.0;
-        for (int axis : {a, b}) {
-            if (edge[axis] == 0 || edge[axis] == m_grid.cells(axis)) {
-                fraction *= HALF;
-            }
-        }
-        return fraction;
-    }
-
-    void shear_strain_terms(std::vector<Eigen::Triplet<double>>& triplets,
-                            Eigen::VectorXd& rhs) const {
+    void set_edge_weights(const WallOptions& walls) {
         for (int c = 0; c < 3; ++c) {
             const int a = (c + 1) % 3;
             const int b = (c + 2) % 3;
-            std::array<int, 3> extent = {m_grid.nx() + 1, m_grid.ny() + 1, m_grid.nz() + 1};
-            extent[c] -= 1;  // edges parallel to axis c sit at cell-centre height along c
-            std::array<int, 3> edge;
-            for (edge[2] = 0; edge[2] < extent[2]; ++edge[2]) {
-                for (edge[1] = 0; edge[1] < extent[1]; ++edge[1]) {
-                    for (edge[0] = 0; edge[0] < extent[0]; ++edge[0]) {
-                        StrainTerm term;
-                        if (!add_derivative(a, b, edge, term) ||
-                            !add_derivative(b, a, edge, term)) {
-                            continue;
+            Array3<double>& weight = m_edge_weight[c];
+            for (int k = 0; k < weight.nk(); ++k) {
+                for (int j = 0; j < weight.nj(); ++j) {
+                    for (int i = 0; i < weight.ni(); ++i) {
+                        const Index3 e = {i, j, k};
+                        double fraction = 1.0;
+                        bool free_slip = false;
+                        for (int axis : {a, b}) {
+                            if (e[axis] == 0 || e[axis] == m_n[axis]) {
+                                fraction *= HALF;  // half the edge's dual cell is outside
+                                const int side = e[axis] == 0 ? 0 : 1;
+                                free_slip |= walls.at(axis, side) == WallType::free_slip;
+                            }
                         }
-                        add_term(term,
-                                 SHEAR_WEIGHT * edge_volume_fraction(edge, a, b) *
-                                     edge_viscosity(edge, a, b),
-                                 triplets, rhs);
+                        if (free_slip) {
+                            continue;  // zero shear stress on a free-slip wall
+                        }
+                        double sum = 0.0;
+                        int count = 0;
+                        for (int da = -1; da <= 0; ++da) {
+                            for (int db = -1; db <= 0; ++db) {
+                                Index3 cell = e;
+                                cell[a] += da;
+                                cell[b] += db;
+                                if (m_mu.contains(cell[0], cell[1], cell[2])) {
+                                    sum += m_mu(cell[0], cell[1], cell[2]);
+                                    ++count;
+                                }
+                            }
+                        }
+                        weight(i, j, k) = SHEAR_WEIGHT * fraction * sum / count;
                     }
                 }
             }
         }
     }
 
-    const MacGrid& m_grid;
-    const Array3<double>& m_phi;
-    const PhaseOptions& m_phases;
-    FluidMode m_mode;
-    const WallOptions& m_walls;
+    void set_faces(const MacGrid& grid, const Array3<double>& phi, const PhaseOptions& phases,
+                   FluidMode mode) {
+        m_unknown.assign(m_size, 0);
+        m_density.assign(m_size, 0.0);
+        for (int a = 0; a < 3; ++a) {
+            for_each_face(a, [&](const Index3& f, std::size_t flat) {
+                Index3 lo = f;
+                --lo[a];
+                const double phi_lo = phi(lo[0], lo[1], lo[2]);
+                const double phi_hi = phi(f[0], f[1], f[2]);
+                if (mode == FluidMode::free_surface && !is_liquid(phi_lo) && !is_liquid(phi_hi)) {
+                    return;
+                }
+                m_unknown[flat] = 1;
+                m_density[flat] = face_density(liquid_fraction(phi_lo, phi_hi), phases, mode);
+            });
+        }
+        (void)grid;
+    }
+
+    /// σ_a(cell) = 2Δt μ_c ∂_a x_a.
+    void normal_stresses(const std::vector<double>& x) const {
+        const double scale = 2.0 * m_dt / m_dx;
+        for (int a = 0; a < 3; ++a) {
+            Array3<double>& sigma = m_normal_stress[a];
+            tbb::parallel_for(
+                tbb::blocked_range<int>(0, m_n[2]), [&](const tbb::blocked_range<int>& r) {
+                    for (int k = r.begin(); k != r.end(); ++k) {
+                        for (int j = 0; j < m_n[1]; ++j) {
+                            for (int i = 0; i < m_n[0]; ++i) {
+                                const Index3 c = {i, j, k};
+                                Index3 hi = c;
+                                ++hi[a];
+                                sigma(i, j, k) = scale * m_mu(i, j, k) *
+                                                 (x[face_flat(a, hi)] - x[face_flat(a, c)]);
+                            }
+                        }
+                    }
+                });
+        }
+    }
+
+    /// ∂_b x_a at edge e (dual-lattice indices), with the no-slip mirror at walls.
+    double derivative(const std::vector<double>& x, int a, int b, const Index3& e) const {
+        Index3 lo = e;
+        --lo[b];
+        if (e[b] == 0) {
+            return MIRROR_FACTOR * x[face_flat(a, e)] / m_dx;
+        }
+        if (e[b] == m_n[b]) {
+            return -MIRROR_FACTOR * x[face_flat(a, lo)] / m_dx;
+        }
+        return (x[face_flat(a, e)] - x[face_flat(a, lo)]) / m_dx;
+    }
+
+    /// τ(edge) = 2Δt W_e (∂_b x_a + ∂_a x_b) on edges parallel to c, (a, b) the other axes.
+    void shear_stresses(const std::vector<double>& x) const {
+        for (int c = 0; c < 3; ++c) {
+            const int a = (c + 1) % 3;
+            const int b = (c + 2) % 3;
+            const Array3<double>& weight = m_edge_weight[c];
+            Array3<double>& tau = m_shear_stress[c];
+            tbb::parallel_for(
+                tbb::blocked_range<int>(0, weight.nk()), [&](const tbb::blocked_range<int>& r) {
+                    for (int k = r.begin(); k != r.end(); ++k) {
+                        for (int j = 0; j < weight.nj(); ++j) {
+                            for (int i = 0; i < weight.ni(); ++i) {
+                                const double w = weight(i, j, k);
+                                if (w == 0.0) {
+                                    tau(i, j, k) = 0.0;
+                                    continue;
+                                }
+                                const Index3 e = {i, j, k};
+                                tau(i, j, k) = 2.0 * m_dt * w *
+                                               (derivative(x, a, b, e) + derivative(x, b, a, e));
+                            }
+                        }
+                    }
+                });
+        }
+    }
+
+    /// y_f = Σ over the strain terms containing face f of stress × coefficient.
+    void stress_divergence(std::vector<double>& y) const {
+        const double inv_dx = 1.0 / m_dx;
+        for (int a = 0; a < 3; ++a) {
+            const Array3<double>& sigma = m_normal_stress[a];
+            for_each_face(a, [&](const Index3& f, std::size_t flat) {
+                Index3 lo = f;
+                --lo[a];
+                double sum = (sigma(lo[0], lo[1], lo[2]) - sigma(f[0], f[1], f[2])) * inv_dx;
+                for (int b = 0; b < 3; ++b) {
+                    if (b == a) {
+                        continue;
+                    }
+                    const Array3<double>& tau = m_shear_stress[3 - a - b];
+                    Index3 above = f;
+                    ++above[b];
+                    const double c_below = (f[b] == 0 ? MIRROR_FACTOR : 1.0) * inv_dx;
+                    const double c_above = -(above[b] == m_n[b] ? MIRROR_FACTOR : 1.0) * inv_dx;
+                    sum += tau(f[0], f[1], f[2]) * c_below +
+                           tau(above[0], above[1], above[2]) * c_above;
+                }
+                y[flat] = sum;
+            });
+        }
+    }
+
+    Index3 m_n;
+    double m_dx;
     double m_dt;
-    std::array<std::vector<std::int64_t>, 3> m_unknown;
-    std::int64_t m_count = 0;
-    Array3<double> m_mu;
+    std::array<Index3, 3> m_face_dims;
+    std::array<std::size_t, 3> m_offset{};
+    std::size_t m_size = 0;
+    Array3<double> m_mu;                          ///< μ per cell
+    std::array<Array3<double>, 3> m_edge_weight;  ///< W_e per edge, by the axis it is parallel to
+    std::vector<char> m_unknown;                  ///< 1 on faces that are solved for
+    std::vector<double> m_density;                ///< ρ_f on unknown faces
+    mutable std::array<Array3<double>, 3> m_normal_stress;  ///< scratch: σ_aa at cells
+    mutable std::array<Array3<double>, 3> m_shear_stress;   ///< scratch: τ on edges
 };
 
 }  // namespace
@@ -290,24 +338,60 @@ SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
         result.converged = true;
         return result;
     }
-    ViscousSystem system(grid, interface, phases, mode, walls, dt);
-    if (system.unknown_count() == 0) {
-        result.converged = true;
-        return result;
+    const ViscousOperator op(grid, interface.phi, phases, mode, walls, dt);
+    const std::vector<char>& unknown = op.unknown();
+    const std::size_t n = op.size();
+    // Split u* into the unknowns x (initial guess) and the fixed faces; b = ρ u* − K u_fixed.
+    const std::vector<double> u_star = op.gather(grid);
+    std::vector<double> fixed(n, 0.0), x(n, 0.0), b(n, 0.0);
+    for (std::size_t f = 0; f < n; ++f) {
+        (unknown[f] ? x[f] : fixed[f]) = u_star[f];
     }
-    Eigen::SparseMatrix<double> matrix;
-    Eigen::VectorXd rhs, guess;
-    system.assemble(matrix, rhs, guess);
-    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver;
-    solver.setTolerance(options.iteration.tolerance);
-    solver.setMaxIterations(options.iteration.max_iterations);
-    solver.compute(matrix);
-    const Eigen::VectorXd solution = solver.solveWithGuess(rhs, guess);
-    result.iterations = static_cast<int>(solver.iterations());
-    result.residual = solver.error();
-    result.converged =
-        solver.info() == Eigen::Success && result.residual <= options.iteration.tolerance;
-    system.scatter(solution, grid);
+    op.stiffness(fixed, b);
+    for (std::size_t f = 0; f < n; ++f) {
+        b[f] = unknown[f] ? op.density()[f] * u_star[f] - b[f] : 0.0;
+    }
+    const double b_norm = std::sqrt(dot(b, b));
+    if (b_norm == 0.0) {
+        x.assign(n, 0.0);
+        result.converged = true;
+    } else {
+        // Jacobi-preconditioned CG from the initial guess u*.
+        const std::vector<double> diagonal = op.diagonal();
+        std::vector<double> r(n), z(n), p(n), q(n);
+        op.apply(x, q);
+        for (std::size_t f = 0; f < n; ++f) {
+            r[f] = b[f] - q[f];
+            z[f] = r[f] / diagonal[f];
+        }
+        p = z;
+        double rz = dot(r, z);
+        result.residual = std::sqrt(dot(r, r)) / b_norm;
+        result.converged = result.residual <= options.iteration.tolerance;
+        while (!result.converged && result.iterations < options.iteration.max_iterations) {
+            op.apply(p, q);
+            const double curvature = dot(p, q);
+            if (!(curvature > 0.0)) {
+                break;
+            }
+            const double alpha = rz / curvature;
+            axpy(alpha, p, x);
+            axpy(-alpha, q, r);
+            ++result.iterations;
+            result.residual = std::sqrt(dot(r, r)) / b_norm;
+            result.converged = result.residual <= options.iteration.tolerance;
+            for (std::size_t f = 0; f < n; ++f) {
+                z[f] = r[f] / diagonal[f];
+            }
+            const double rz_new = dot(r, z);
+            xpby(z, rz_new / rz, p);
+            rz = rz_new;
+        }
+    }
+    for (std::size_t f = 0; f < n; ++f) {
+        x[f] += fixed[f];
+    }
+    op.scatter(x, grid);
     return result;
 }
 

@@ -9,8 +9,8 @@
 /// diagonal strain rates live at cell centres, the shear strain rates on cell edges (ε_xy on
 /// z-parallel edges at (i·dx, j·dx, (k+½)·dx), etc.). μ_c is the viscosity of the cell's phase,
 /// μ_e the average over the (up to 4) cells around the edge, ρ_f the face density of
-/// face_density(). The system is symmetric positive definite and solved by conjugate gradients
-/// (Eigen, Jacobi preconditioner) starting from u*.
+/// face_density(). The system is symmetric positive definite and solved matrix-free by conjugate
+/// gradients with a Jacobi preconditioner, starting from u* (TBB-parallel operator).
 ///
 /// Boundaries: wall-normal faces keep their stored value. On a no-slip wall the tangential
 /// velocity is mirrored with opposite sign (zero at the wall) and the edge terms on that wall are
