@@ -175,20 +175,28 @@ private:
                         if (free_slip) {
                             continue;  // zero shear stress on a free-slip wall
                         }
-                        double sum = 0.0;
+                        // Harmonic mean of the (up to 4) cells around the edge: exact for the
+                        // shear stress across a layer interface through the edge; 0 next to a
+                        // cell with μ = 0 (the traction-free void of free_surface mode).
+                        double inverse_sum = 0.0;
                         int count = 0;
+                        bool inviscid = false;
                         for (int da = -1; da <= 0; ++da) {
                             for (int db = -1; db <= 0; ++db) {
                                 Index3 cell = e;
                                 cell[a] += da;
                                 cell[b] += db;
                                 if (m_mu.contains(cell[0], cell[1], cell[2])) {
-                                    sum += m_mu(cell[0], cell[1], cell[2]);
+                                    const double mu = m_mu(cell[0], cell[1], cell[2]);
+                                    inviscid |= mu == 0.0;
+                                    inverse_sum += inviscid ? 0.0 : 1.0 / mu;
                                     ++count;
                                 }
                             }
                         }
-                        weight(i, j, k) = SHEAR_WEIGHT * fraction * sum / count;
+                        if (!inviscid) {
+                            weight(i, j, k) = SHEAR_WEIGHT * fraction * count / inverse_sum;
+                        }
                     }
                 }
             }

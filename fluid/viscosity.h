@@ -8,7 +8,8 @@
 /// (all multiplied by the cell volume), i.e. ρ (u − u*)/Δt = ∇·(2 μ ε(u)), ε = ½(∇u + ∇uᵀ). The
 /// diagonal strain rates live at cell centres, the shear strain rates on cell edges (ε_xy on
 /// z-parallel edges at (i·dx, j·dx, (k+½)·dx), etc.). μ_c is the viscosity of the cell's phase,
-/// μ_e the average over the (up to 4) cells around the edge, ρ_f the face density of
+/// μ_e the harmonic mean over the (up to 4) cells around the edge
+/// (zero next to a cell with μ = 0), ρ_f the face density of
 /// face_density(). The system is symmetric positive definite and solved matrix-free by conjugate
 /// gradients with a Jacobi preconditioner, starting from u* (TBB-parallel operator).
 ///
