@@ -4,6 +4,7 @@
 #include "coupling/vdb_output.h"
 #include "tracker/flows/velocity_field.h"
 #include "tracker/implicit_mesher.h"
+#include "tracker/mesh_intersections.h"
 #include "tracker/mesh_io.h"
 #include "tracker/mesh_measures.h"
 #include "tracker/mesh_validate.h"
@@ -115,6 +116,19 @@ nlohmann::json frame_stats(int frame, double time, double dt, long long steps,
             {"seconds", {{"motion", seconds.motion}, {"output", seconds.output}}}};
 }
 
+/// Throws InputError listing the first intersecting triangle pairs, if any.
+void check_intersection_free(const SurfaceMesh& mesh, const std::string& what) {
+    const tracker::IntersectionReport r = tracker::find_self_intersections(mesh);
+    if (r.intersection_free())
+        return;
+    std::ostringstream s;
+    s << what << ": the surface intersects itself (" << r.triangle_pairs.size()
+      << " triangle pairs), e.g.";
+    for (size_t i = 0; i < r.triangle_pairs.size() && i < MAX_LISTED_VIOLATIONS; ++i)
+        s << " (" << r.triangle_pairs[i].ti << ", " << r.triangle_pairs[i].tj << ")";
+    throw InputError(s.str());
+}
+
 }  // namespace
 
 SurfaceMesh build_initial_surface(const Scene& scene, std::string* report) {
@@ -129,6 +143,9 @@ SurfaceMesh build_initial_surface(const Scene& scene, std::string* report) {
         } catch (const std::exception& e) {
             throw InputError(scene.source_path + ": /surface: " + e.what());
         }
+        check_intersection_free(mesh, scene.source_path +
+                                          ": /surface/shape meshed at edge_length " +
+                                          std::to_string(scene.surface.edge_length));
         if (report) {
             std::ostringstream s;
             s << "meshed shape: " << r.vertices << " vertices, " << r.triangles
@@ -156,6 +173,7 @@ SurfaceMesh build_initial_surface(const Scene& scene, std::string* report) {
             s << "\n  ... and " << violations.size() - MAX_LISTED_VIOLATIONS << " more";
         throw InputError(s.str());
     }
+    check_intersection_free(mesh, file);
     if (report) {
         std::ostringstream s;
         s << "loaded " << file << ": " << mesh.count_live_vertices() << " vertices, "

@@ -167,6 +167,20 @@ TEST_F(CliTest, DuplicateTriangleInMeshFileIsRejected) {
     EXPECT_NE(o.output.find("duplicate triangle"), std::string::npos) << o.output;
 }
 
+TEST_F(CliTest, SelfIntersectingMeshFileIsRejected) {
+    // Two octahedra overlapping: closed and oriented, but the surfaces cross.
+    std::string obj = OCTAHEDRON_OBJ;
+    obj +=
+        "v 1.5 0 0\nv -0.5 0 0\nv 0.5 1 0\nv 0.5 -1 0\nv 0.5 0 1\nv 0.5 0 -1\n"
+        "f 7 9 11\nf 9 8 11\nf 8 10 11\nf 10 7 11\nf 9 7 12\nf 8 9 12\nf 10 8 12\nf 7 10 12\n";
+    write("crossing.obj", obj);
+    const std::string scene = write("s.json", R"({"surface": {"mesh_file": "crossing.obj"}})");
+    const Outcome o = run_meniscus("run " + scene + " --out " + (m_dir / "out").string());
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("crossing.obj: the surface intersects itself"), std::string::npos)
+        << o.output;
+}
+
 TEST_F(CliTest, RunWritesEveryFrameAndStats) {
     const std::string scene = write("small.json", SMALL_SCENE);
     const fs::path out = m_dir / "out";

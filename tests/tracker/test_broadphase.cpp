@@ -1,0 +1,134 @@
+#include "tracker/broadphase.h"
+#include "tracker/implicit_mesher.h"
+#include "tracker/mesh_intersections.h"
+#include "tracker/mesh_io.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace meniscus::tracker {
+namespace {
+
+SurfaceMesh meshed(const ShapePtr& shape, double h) {
+    ImplicitMeshOptions o;
+    o.edge_length = h;
+    return mesh_implicit_shape(*shape, o);
+}
+
+std::vector<Vec3> randomly_moved(const SurfaceMesh& m, double amplitude, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> n(0.0, amplitude);
+    std::vector<Vec3> x = m.positions();
+    for (Vec3& p : x)
+        p += Vec3(n(rng), n(rng), n(rng));
+    return x;
+}
+
+template <typename Pair>
+bool includes(std::vector<Pair> super, std::vector<Pair> sub) {
+    std::sort(super.begin(), super.end());
+    std::sort(sub.begin(), sub.end());
+    return std::includes(super.begin(), super.end(), sub.begin(), sub.end());
+}
+
+class BroadPhaseSuperset : public testing::TestWithParam<int> {};
+
+TEST_P(BroadPhaseSuperset, EqualsBruteForceOnRandomMotion) {
+    const int seed = GetParam();
+    const SurfaceMesh m = meshed(
+        make_union({make_sphere({0, 0, 0}, 0.2), make_torus({0.25, 0, 0}, {1, 1, 0}, 0.2, 0.06)}),
+        0.04);
+    // Step sizes from tiny to several edge lengths (boxes spanning many cells).
+    const double amplitude = 0.001 * std::pow(4.0, seed % 6);
+    const std::vector<Vec3> x0 = randomly_moved(m, 0.1 * amplitude, 100 + seed);
+    const std::vector<Vec3> x1 = randomly_moved(m, amplitude, 200 + seed);
+    const double padding = (seed % 3) * 0.01;
+    const BroadPhase broad(m, x0, x1, padding);
+    const auto vt = broad.vertex_triangle_pairs();
+    const auto ee = broad.edge_edge_pairs();
+    const auto vt_ref = brute_force_vertex_triangle_pairs(m, x0, x1, padding);
+    const auto ee_ref = brute_force_edge_edge_pairs(m, x0, x1, padding);
+    // A superset, and since the final filter is the same exact box test, exactly equal.
+    EXPECT_TRUE(includes(vt, vt_ref));
+    EXPECT_TRUE(includes(ee, ee_ref));
+    EXPECT_EQ(vt.size(), vt_ref.size());
+    EXPECT_EQ(ee.size(), ee_ref.size());
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, BroadPhaseSuperset, testing::Range(0, 12));
+
+TEST(SpatialHash, InsertRemoveUpdateQuery) {
+    SpatialHash h(0.5);
+    h.insert(3, Box3d(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+    h.insert(7, Box3d(Vec3(2, 2, 2), Vec3(3, 3, 3)));
+    h.insert(9, Box3d(Vec3(-1e6, -1e6, -1e6), Vec3(1e6, 1e6, 1e6)));  // oversized
+    std::vector<int> out;
+    h.query(Box3d(Vec3(0.9, 0.9, 0.9), Vec3(2.1, 2.1, 2.1)), out);
+    EXPECT_EQ(out, (std::vector<int>{3, 7, 9}));
+    h.remove(3);
+    h.query(Box3d(Vec3(0.5, 0.5, 0.5), Vec3(0.6, 0.6, 0.6)), out);
+    EXPECT_EQ(out, (std::vector<int>{9}));
+    h.insert(7, Box3d(Vec3(0.5, 0.5, 0.5), Vec3(0.55, 0.55, 0.55)));  // moved
+    h.query(Box3d(Vec3(0.5, 0.5, 0.5), Vec3(0.6, 0.6, 0.6)), out);
+    EXPECT_EQ(out, (std::vector<int>{7, 9}));
+    h.query(Box3d(Vec3(2, 2, 2), Vec3(3, 3, 3)), out);
+    EXPECT_EQ(out, (std::vector<int>{9}));
+    // Touching boxes count (closed boxes).
+    h.query(Box3d(Vec3(0.55, 0.55, 0.55), Vec3(0.7, 0.7, 0.7)), out);
+    EXPECT_EQ(out, (std::vector<int>{7, 9}));
+}
+
+TEST(MeshIntersections, GeneratedMeshesAreIntersectionFree) {
+    for (const auto& shape :
+         {make_sphere({0, 0, 0}, 0.3), make_torus({0, 0, 0}, {0, 0, 1}, 0.3, 0.05),
+          make_dumbbell({0, 0, 0}, 0.4, 1.0, 0.2, 0.05),
+          make_union({make_sphere({-0.25, 0, 0}, 0.2), make_sphere({0.25, 0, 0}, 0.2)})}) {
+        const SurfaceMesh m = meshed(shape, 0.03);
+        const IntersectionReport r = find_self_intersections(m);
+        EXPECT_TRUE(r.intersection_free()) << r.triangle_pairs.size() << " intersecting pairs";
+        EXPECT_TRUE(is_intersection_free(m));
+    }
+}
+
+TEST(MeshIntersections, FindsInterpenetratingSpheres) {
+    // Two separately meshed spheres overlapping: the union of their meshes intersects itself.
+    const SurfaceMesh a = meshed(make_sphere({0, 0, 0}, 0.2), 0.04);
+    const SurfaceMesh b = meshed(make_sphere({0.3, 0, 0}, 0.2), 0.04);
+    std::vector<Vec3> x = a.positions();
+    std::vector<Triangle> t;
+    for (int ti = 0; ti < a.num_triangles(); ++ti)
+        t.push_back(a.triangle(ti));
+    const int offset = static_cast<int>(x.size());
+    x.insert(x.end(), b.positions().begin(), b.positions().end());
+    for (int ti = 0; ti < b.num_triangles(); ++ti) {
+        Triangle tb = b.triangle(ti);
+        for (int& v : tb)
+            v += offset;
+        t.push_back(tb);
+    }
+    const SurfaceMesh both(x, t);
+    const IntersectionReport r = find_self_intersections(both);
+    EXPECT_FALSE(r.intersection_free());
+    EXPECT_FALSE(r.edge_triangle_pairs.empty());
+    EXPECT_FALSE(is_intersection_free(both));
+    // Every reported pair mixes the two spheres.
+    for (const TrianglePair& p : r.triangle_pairs)
+        EXPECT_NE(p.ti < a.num_triangles(), p.tj < a.num_triangles());
+    // Moving b away removes every intersection.
+    std::vector<Vec3> apart = both.positions();
+    for (size_t i = static_cast<size_t>(offset); i < apart.size(); ++i)
+        apart[i].x() += 0.2;
+    EXPECT_TRUE(is_intersection_free(both, &apart));
+}
+
+TEST(MeshIntersections, FoldedNeighbourCounts) {
+    // Two triangles on a shared edge folded flat onto each other intersect.
+    const SurfaceMesh m({{0, 0, 0}, {1, 0, 0}, {0.3, 1, 0}, {0.6, 1, 0}}, {{0, 1, 2}, {1, 0, 3}});
+    EXPECT_FALSE(is_intersection_free(m));
+    const SurfaceMesh ok({{0, 0, 0}, {1, 0, 0}, {0.3, 1, 0}, {0.6, -1, 0}}, {{0, 1, 2}, {1, 0, 3}});
+    EXPECT_TRUE(is_intersection_free(ok));
+}
+
+}  // namespace
+}  // namespace meniscus::tracker

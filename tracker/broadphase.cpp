@@ -1,0 +1,346 @@
+#include "tracker/broadphase.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace meniscus::tracker {
+
+namespace {
+
+/// Boxes covering more cells than this are kept in a list checked on every query instead.
+constexpr long long MAX_CELLS_PER_BOX = 512;
+/// Grain of parallel pair enumeration.
+constexpr size_t PARALLEL_GRAIN = 256;
+
+bool overlaps(const Box3d& a, const Box3d& b) {
+    return (a.min().array() <= b.max().array()).all() && (b.min().array() <= a.max().array()).all();
+}
+
+/// Cell size from the mean box extent of the elements (never below a tiny fraction of the
+/// largest extent, so degenerate meshes still hash).
+double pick_cell_size(const std::vector<Box3d>& boxes) {
+    double sum = 0.0, largest = 0.0;
+    int n = 0;
+    for (const Box3d& b : boxes) {
+        if (b.isEmpty())
+            continue;
+        const double e = b.sizes().maxCoeff();
+        sum += e;
+        largest = std::max(largest, e);
+        ++n;
+    }
+    if (n == 0)
+        return 1.0;
+    const double mean = sum / n;
+    const double cell = std::max(mean, largest * 1e-6);
+    return cell > 0.0 ? cell : 1.0;
+}
+
+template <typename Pair, typename Emit>
+std::vector<Pair> collect_parallel(size_t count, Emit&& emit) {
+    tbb::enumerable_thread_specific<std::vector<Pair>> local;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, PARALLEL_GRAIN),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          auto& out = local.local();
+                          std::vector<int> scratch;
+                          for (size_t i = r.begin(); i < r.end(); ++i)
+                              emit(static_cast<int>(i), scratch, out);
+                      });
+    std::vector<Pair> all;
+    for (auto& part : local)
+        all.insert(all.end(), part.begin(), part.end());
+    std::sort(all.begin(), all.end());
+    return all;
+}
+
+bool shares_vertex(const Edge& a, const Edge& b) {
+    return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
+}
+
+void check_sizes(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
+                 const std::vector<Vec3>& x_t1, double padding) {
+    const size_t n = static_cast<size_t>(mesh.num_vertices());
+    if (x_t0.size() != n || x_t1.size() != n)
+        throw std::invalid_argument("broad phase: " + std::to_string(x_t0.size()) + " and " +
+                                    std::to_string(x_t1.size()) + " positions for " +
+                                    std::to_string(n) + " vertices");
+    if (!(padding >= 0.0))
+        throw std::invalid_argument("broad phase: padding must be >= 0");
+}
+
+Box3d vertex_box(const std::vector<Vec3>& x_t0, const std::vector<Vec3>& x_t1, int vi,
+                 double padding) {
+    return swept_box({&x_t0[static_cast<size_t>(vi)]}, {&x_t1[static_cast<size_t>(vi)]}, padding);
+}
+
+Box3d edge_box(const std::vector<Vec3>& x_t0, const std::vector<Vec3>& x_t1, const Edge& e,
+               double padding) {
+    const auto a = static_cast<size_t>(e[0]), b = static_cast<size_t>(e[1]);
+    return swept_box({&x_t0[a], &x_t0[b]}, {&x_t1[a], &x_t1[b]}, padding);
+}
+
+Box3d triangle_box(const std::vector<Vec3>& x_t0, const std::vector<Vec3>& x_t1, const Triangle& t,
+                   double padding) {
+    const auto a = static_cast<size_t>(t[0]), b = static_cast<size_t>(t[1]),
+               c = static_cast<size_t>(t[2]);
+    return swept_box({&x_t0[a], &x_t0[b], &x_t0[c]}, {&x_t1[a], &x_t1[b], &x_t1[c]}, padding);
+}
+
+}  // namespace
+
+Box3d swept_box(std::initializer_list<const Vec3*> p_t0, std::initializer_list<const Vec3*> p_t1,
+                double padding) {
+    Box3d b;
+    for (const Vec3* p : p_t0)
+        b.extend(*p);
+    for (const Vec3* p : p_t1)
+        b.extend(*p);
+    b.min().array() -= padding;
+    b.max().array() += padding;
+    return b;
+}
+
+// ---- SpatialHash ------------------------------------------------------------------------
+
+SpatialHash::SpatialHash(double cell_size) : m_cell(cell_size) {
+    if (!(cell_size > 0.0) || !std::isfinite(cell_size))
+        throw std::invalid_argument("SpatialHash: cell_size must be a finite number > 0");
+}
+
+std::uint64_t SpatialHash::key(int i, int j, int k) {
+    // Large-prime mixing; distinct cells may share a key, which only merges candidate lists
+    // (the exact box filter removes the extras).
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) * 73856093ULL) ^
+           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(j)) * 19349663ULL << 21) ^
+           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k)) * 83492791ULL << 42);
+}
+
+SpatialHash::CellRange SpatialHash::cells_of(const Box3d& box) const {
+    CellRange r;
+    const Eigen::Array3d lo = (box.min().array() / m_cell).floor();
+    const Eigen::Array3d hi = (box.max().array() / m_cell).floor();
+    const double limit = std::numeric_limits<int>::max() / 2;
+    if ((lo.abs() > limit).any() || (hi.abs() > limit).any() || !lo.allFinite() ||
+        !hi.allFinite()) {
+        r.oversized = true;
+        return r;
+    }
+    r.lo = lo.cast<int>();
+    r.hi = hi.cast<int>();
+    const Eigen::Array3d span = (hi - lo) + 1.0;
+    r.oversized = span.prod() > static_cast<double>(MAX_CELLS_PER_BOX);
+    return r;
+}
+
+void SpatialHash::insert(int id, const Box3d& box) {
+    if (id < 0)
+        throw std::invalid_argument("SpatialHash::insert: negative id");
+    remove(id);
+    const auto i = static_cast<size_t>(id);
+    if (m_boxes.size() <= i) {
+        m_boxes.resize(i + 1);
+        m_ranges.resize(i + 1);
+        m_present.resize(i + 1, 0);
+    }
+    m_boxes[i] = box;
+    m_ranges[i] = cells_of(box);
+    m_present[i] = 1;
+    const CellRange& r = m_ranges[i];
+    if (r.oversized) {
+        m_oversized.push_back(id);
+        return;
+    }
+    for (int z = r.lo.z(); z <= r.hi.z(); ++z)
+        for (int y = r.lo.y(); y <= r.hi.y(); ++y)
+            for (int x = r.lo.x(); x <= r.hi.x(); ++x)
+                m_grid[key(x, y, z)].push_back(id);
+}
+
+void SpatialHash::remove(int id) {
+    if (!contains(id))
+        return;
+    const auto i = static_cast<size_t>(id);
+    const CellRange& r = m_ranges[i];
+    const auto erase = [id](std::vector<int>& list) {
+        auto it = std::find(list.begin(), list.end(), id);
+        if (it != list.end()) {
+            *it = list.back();
+            list.pop_back();
+        }
+    };
+    if (r.oversized) {
+        erase(m_oversized);
+    } else {
+        for (int z = r.lo.z(); z <= r.hi.z(); ++z)
+            for (int y = r.lo.y(); y <= r.hi.y(); ++y)
+                for (int x = r.lo.x(); x <= r.hi.x(); ++x) {
+                    auto it = m_grid.find(key(x, y, z));
+                    if (it == m_grid.end())
+                        continue;
+                    erase(it->second);
+                    if (it->second.empty())
+                        m_grid.erase(it);
+                }
+    }
+    m_present[i] = 0;
+}
+
+bool SpatialHash::contains(int id) const {
+    return id >= 0 && static_cast<size_t>(id) < m_present.size() &&
+           m_present[static_cast<size_t>(id)];
+}
+
+void SpatialHash::query(const Box3d& box, std::vector<int>& out) const {
+    out.clear();
+    const CellRange r = cells_of(box);
+    if (r.oversized) {
+        for (size_t i = 0; i < m_present.size(); ++i)
+            if (m_present[i] && overlaps(m_boxes[i], box))
+                out.push_back(static_cast<int>(i));
+        return;
+    }
+    for (int z = r.lo.z(); z <= r.hi.z(); ++z)
+        for (int y = r.lo.y(); y <= r.hi.y(); ++y)
+            for (int x = r.lo.x(); x <= r.hi.x(); ++x) {
+                auto it = m_grid.find(key(x, y, z));
+                if (it == m_grid.end())
+                    continue;
+                for (int id : it->second)
+                    if (overlaps(m_boxes[static_cast<size_t>(id)], box))
+                        out.push_back(id);
+            }
+    for (int id : m_oversized)
+        if (overlaps(m_boxes[static_cast<size_t>(id)], box))
+            out.push_back(id);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+void SpatialHash::clear() {
+    m_grid.clear();
+    m_oversized.clear();
+    m_boxes.clear();
+    m_ranges.clear();
+    m_present.clear();
+}
+
+// ---- BroadPhase ---------------------------------------------------------------------------
+
+BroadPhase::BroadPhase(const SurfaceMesh& mesh, double padding)
+    : BroadPhase(mesh, mesh.positions(), mesh.positions(), padding) {}
+
+BroadPhase::BroadPhase(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
+                       const std::vector<Vec3>& x_t1, double padding)
+    : m_mesh(mesh) {
+    check_sizes(mesh, x_t0, x_t1, padding);
+    std::vector<Box3d> tri_boxes(static_cast<size_t>(mesh.num_triangles()));
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        if (mesh.triangle_alive(ti))
+            tri_boxes[static_cast<size_t>(ti)] =
+                triangle_box(x_t0, x_t1, mesh.triangle(ti), padding);
+    const double cell = pick_cell_size(tri_boxes);
+    m_vertices = SpatialHash(cell);
+    m_edges = SpatialHash(cell);
+    m_triangles = SpatialHash(cell);
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        if (mesh.triangle_alive(ti))
+            m_triangles.insert(ti, tri_boxes[static_cast<size_t>(ti)]);
+    for (int ei = 0; ei < mesh.num_edges(); ++ei)
+        if (mesh.edge_alive(ei))
+            m_edges.insert(ei, edge_box(x_t0, x_t1, mesh.edge(ei), padding));
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        if (mesh.vertex_alive(vi) && !mesh.vertex_triangles(vi).empty())
+            m_vertices.insert(vi, vertex_box(x_t0, x_t1, vi, padding));
+}
+
+std::vector<VertexTrianglePair> BroadPhase::vertex_triangle_pairs() const {
+    return collect_parallel<VertexTrianglePair>(
+        static_cast<size_t>(m_mesh.num_vertices()),
+        [&](int vi, std::vector<int>& scratch, std::vector<VertexTrianglePair>& out) {
+            if (!m_vertices.contains(vi))
+                return;
+            m_triangles.query(m_vertices.box(vi), scratch);
+            for (int ti : scratch) {
+                const Triangle& t = m_mesh.triangle(ti);
+                if (t[0] != vi && t[1] != vi && t[2] != vi)
+                    out.push_back({vi, ti});
+            }
+        });
+}
+
+std::vector<EdgeEdgePair> BroadPhase::edge_edge_pairs() const {
+    return collect_parallel<EdgeEdgePair>(
+        static_cast<size_t>(m_mesh.num_edges()),
+        [&](int ei, std::vector<int>& scratch, std::vector<EdgeEdgePair>& out) {
+            if (!m_edges.contains(ei))
+                return;
+            m_edges.query(m_edges.box(ei), scratch);
+            for (int ej : scratch)
+                if (ej > ei && !shares_vertex(m_mesh.edge(ei), m_mesh.edge(ej)))
+                    out.push_back({ei, ej});
+        });
+}
+
+std::vector<TrianglePair> BroadPhase::triangle_pairs() const {
+    return collect_parallel<TrianglePair>(
+        static_cast<size_t>(m_mesh.num_triangles()),
+        [&](int ti, std::vector<int>& scratch, std::vector<TrianglePair>& out) {
+            if (!m_triangles.contains(ti))
+                return;
+            m_triangles.query(m_triangles.box(ti), scratch);
+            for (int tj : scratch)
+                if (tj > ti)
+                    out.push_back({ti, tj});
+        });
+}
+
+std::vector<VertexTrianglePair> brute_force_vertex_triangle_pairs(const SurfaceMesh& mesh,
+                                                                  const std::vector<Vec3>& x_t0,
+                                                                  const std::vector<Vec3>& x_t1,
+                                                                  double padding) {
+    check_sizes(mesh, x_t0, x_t1, padding);
+    std::vector<VertexTrianglePair> out;
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty())
+            continue;
+        const Box3d vb = vertex_box(x_t0, x_t1, vi, padding);
+        for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+            if (!mesh.triangle_alive(ti))
+                continue;
+            const Triangle& t = mesh.triangle(ti);
+            if (t[0] == vi || t[1] == vi || t[2] == vi)
+                continue;
+            if (overlaps(vb, triangle_box(x_t0, x_t1, t, padding)))
+                out.push_back({vi, ti});
+        }
+    }
+    return out;
+}
+
+std::vector<EdgeEdgePair> brute_force_edge_edge_pairs(const SurfaceMesh& mesh,
+                                                      const std::vector<Vec3>& x_t0,
+                                                      const std::vector<Vec3>& x_t1,
+                                                      double padding) {
+    check_sizes(mesh, x_t0, x_t1, padding);
+    std::vector<EdgeEdgePair> out;
+    for (int ei = 0; ei < mesh.num_edges(); ++ei) {
+        if (!mesh.edge_alive(ei))
+            continue;
+        const Box3d a = edge_box(x_t0, x_t1, mesh.edge(ei), padding);
+        for (int ej = ei + 1; ej < mesh.num_edges(); ++ej) {
+            if (!mesh.edge_alive(ej) || shares_vertex(mesh.edge(ei), mesh.edge(ej)))
+                continue;
+            if (overlaps(a, edge_box(x_t0, x_t1, mesh.edge(ej), padding)))
+                out.push_back({ei, ej});
+        }
+    }
+    return out;
+}
+
+}  // namespace meniscus::tracker

@@ -1,0 +1,131 @@
+#pragma once
+/// \file Broad phase: which mesh elements may interact, from axis-aligned boxes (paper §4.5).
+///
+/// `SpatialHash` stores boxes of one element type in a uniform grid hashed by cell; a box
+/// query returns every stored element whose box overlaps the query box — exactly the brute
+/// force answer, never fewer (every pair of overlapping boxes shares at least one cell, and the
+/// final filter is an exact box-overlap test). Elements can be inserted, removed and updated,
+/// so remeshing can keep it current.
+///
+/// `BroadPhase` holds one hash per element type (vertices, edges, triangles) for a mesh whose
+/// vertices move linearly from x_t0 to x_t1 (swept boxes; static when x_t0 = x_t1) and
+/// enumerates candidate pairs for CCD, proximity and intersection tests.
+
+#include "tracker/mesh.h"
+
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+namespace meniscus::tracker {
+
+using Box3d = Eigen::AlignedBox3d;
+
+/// Dynamic uniform-grid hash of boxes keyed by element index.
+class SpatialHash {
+public:
+    /// `cell_size` (> 0, metres) should be near the typical box extent. Throws otherwise.
+    explicit SpatialHash(double cell_size = 1.0);
+    /// Inserts or replaces element `id`'s box (id ≥ 0).
+    void insert(int id, const Box3d& box);
+    /// Removes element `id` (no-op if absent).
+    void remove(int id);
+    /// Replaces `out` with every element whose box overlaps `box` (closed boxes), each once,
+    /// sorted. Safe to call from several threads at once (no mutation).
+    void query(const Box3d& box, std::vector<int>& out) const;
+    bool contains(int id) const;
+    const Box3d& box(int id) const { return m_boxes[static_cast<size_t>(id)]; }
+    double cell_size() const { return m_cell; }
+    void clear();
+
+private:
+    struct CellRange {
+        Eigen::Array3i lo, hi;
+        bool oversized = false;
+    };
+    CellRange cells_of(const Box3d& box) const;
+    static std::uint64_t key(int i, int j, int k);
+
+    double m_cell;
+    std::unordered_map<std::uint64_t, std::vector<int>> m_grid;
+    std::vector<int> m_oversized;  // boxes spanning too many cells, checked on every query
+    std::vector<Box3d> m_boxes;
+    std::vector<CellRange> m_ranges;
+    std::vector<std::uint8_t> m_present;
+};
+
+/// A vertex and a triangle that does not contain it.
+struct VertexTrianglePair {
+    int vi, ti;
+    friend bool operator==(const VertexTrianglePair& a, const VertexTrianglePair& b) {
+        return a.vi == b.vi && a.ti == b.ti;
+    }
+    friend bool operator<(const VertexTrianglePair& a, const VertexTrianglePair& b) {
+        return a.vi != b.vi ? a.vi < b.vi : a.ti < b.ti;
+    }
+};
+/// Two edges without a common vertex, ei < ej.
+struct EdgeEdgePair {
+    int ei, ej;
+    friend bool operator==(const EdgeEdgePair& a, const EdgeEdgePair& b) {
+        return a.ei == b.ei && a.ej == b.ej;
+    }
+    friend bool operator<(const EdgeEdgePair& a, const EdgeEdgePair& b) {
+        return a.ei != b.ei ? a.ei < b.ei : a.ej < b.ej;
+    }
+};
+/// Two distinct triangles, ti < tj (they may share vertices).
+struct TrianglePair {
+    int ti, tj;
+    friend bool operator==(const TrianglePair& a, const TrianglePair& b) {
+        return a.ti == b.ti && a.tj == b.tj;
+    }
+    friend bool operator<(const TrianglePair& a, const TrianglePair& b) {
+        return a.ti != b.ti ? a.ti < b.ti : a.tj < b.tj;
+    }
+};
+
+/// Candidate pairs of a mesh moving linearly from x_t0 to x_t1.
+class BroadPhase {
+public:
+    /// Builds boxes of all live vertices, edges and triangles swept from x_t0 to x_t1 (both
+    /// sized mesh.num_vertices()), padded by `padding` ≥ 0 metres on every side.
+    /// Throws std::invalid_argument on size mismatch or negative padding.
+    BroadPhase(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
+               const std::vector<Vec3>& x_t1, double padding);
+    /// Static variant: x_t0 = x_t1 = the mesh's positions.
+    BroadPhase(const SurfaceMesh& mesh, double padding);
+
+    /// Vertex–triangle pairs with overlapping boxes, the vertex not in the triangle; sorted.
+    std::vector<VertexTrianglePair> vertex_triangle_pairs() const;
+    /// Edge–edge pairs with overlapping boxes and no shared vertex; sorted.
+    std::vector<EdgeEdgePair> edge_edge_pairs() const;
+    /// Triangle pairs with overlapping boxes (including neighbours); sorted.
+    std::vector<TrianglePair> triangle_pairs() const;
+
+    const SpatialHash& vertices() const { return m_vertices; }
+    const SpatialHash& edges() const { return m_edges; }
+    const SpatialHash& triangles() const { return m_triangles; }
+
+private:
+    const SurfaceMesh& m_mesh;
+    SpatialHash m_vertices, m_edges, m_triangles;
+};
+
+/// Box of points moving linearly from p_t0[i] to p_t1[i], padded by `padding`.
+Box3d swept_box(std::initializer_list<const Vec3*> p_t0, std::initializer_list<const Vec3*> p_t1,
+                double padding);
+
+/// Brute-force references (O(n²)) for tests: the same pairs the broad phase must include.
+std::vector<VertexTrianglePair> brute_force_vertex_triangle_pairs(const SurfaceMesh& mesh,
+                                                                  const std::vector<Vec3>& x_t0,
+                                                                  const std::vector<Vec3>& x_t1,
+                                                                  double padding);
+std::vector<EdgeEdgePair> brute_force_edge_edge_pairs(const SurfaceMesh& mesh,
+                                                      const std::vector<Vec3>& x_t0,
+                                                      const std::vector<Vec3>& x_t1,
+                                                      double padding);
+
+}  // namespace meniscus::tracker
