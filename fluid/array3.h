@@ -29,6 +29,7 @@ public:
         m_data.assign(static_cast<std::size_t>(ni) * nj * nk, value);
     }
 
+    /// Extent along i (fastest), j and k.
     int ni() const { return m_ni; }
     int nj() const { return m_nj; }
     int nk() const { return m_nk; }
@@ -47,6 +48,8 @@ public:
         return i >= 0 && j >= 0 && k >= 0 && i < m_ni && j < m_nj && k < m_nk;
     }
 
+    /// Element (i, j, k); bounds-checked by MENISCUS_ASSERT when asserts are on (use flat
+    /// indices in hot loops).
     T& operator()(int i, int j, int k) {
         MENISCUS_ASSERT(contains(i, j, k), "Array3 index out of range");
         return m_data[index(i, j, k)];
@@ -56,12 +59,14 @@ public:
         return m_data[index(i, j, k)];
     }
 
+    /// Element at flat index i + ni·(j + nj·k), unchecked.
     T& operator[](std::size_t flat) { return m_data[flat]; }
     const T& operator[](std::size_t flat) const { return m_data[flat]; }
 
     /// Sets every element to `value`.
     void fill(T value) { std::fill(m_data.begin(), m_data.end(), value); }
 
+    /// Contiguous storage in flat-index order.
     T* data() { return m_data.data(); }
     const T* data() const { return m_data.data(); }
     std::vector<T>& storage() { return m_data; }

@@ -57,9 +57,9 @@ FieldLocation face_location(int axis);
 
 /// A trilinear sample and the minimum and maximum of the 8 samples it interpolated (for clamping).
 struct TrilinearSample {
-    double value = 0.0;
-    double min = 0.0;
-    double max = 0.0;
+    double value = 0.0;  ///< interpolated value
+    double min = 0.0;    ///< smallest of the 8 samples used
+    double max = 0.0;    ///< largest of the 8 samples used
 };
 
 /// Trilinear interpolation of `field` (stored at `location`) at `grid_position`, a point in cell
@@ -76,6 +76,7 @@ public:
     MacGrid(int nx, int ny, int nz, double dx,
             const Eigen::Vector3d& origin = Eigen::Vector3d::Zero());
 
+    /// Cell counts along x, y and z.
     int nx() const { return m_nx; }
     int ny() const { return m_ny; }
     int nz() const { return m_nz; }
