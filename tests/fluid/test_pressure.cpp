@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <tuple>
 #include <vector>
@@ -91,6 +92,8 @@ TEST_P(FluidPressureSolverTest, TwoPhaseStillWaterIsHydrostaticAtDensityRatio100
         }
     }
     const double scale = phases.rho_liquid * GRAVITY * h;
+    std::printf("two-phase hydrostatic: max |p - p_exact| = %.3e Pa of %.1f Pa, max |u| = %.3e\n",
+                max_error, scale, max_velocity(grid));
     EXPECT_LT(max_error, 1e-7 * scale) << "max hydrostatic error " << max_error << " Pa";
 }
 
@@ -123,6 +126,8 @@ TEST_P(FluidPressureSolverTest, FreeSurfaceStillWaterIsHydrostatic) {
             }
         }
     }
+    std::printf("free-surface hydrostatic: max |p - p_exact| = %.3e Pa, max liquid |w| = %.3e\n",
+                max_error, max_liquid_w);
     EXPECT_LT(max_liquid_w, 1e-7 * GRAVITY * dt);
     EXPECT_LT(max_error, 1e-7 * phases.rho_liquid * GRAVITY * h) << max_error << " Pa";
 }
@@ -160,6 +165,9 @@ TEST_P(FluidPressureSolverTest, FlatInterfaceWithConstantCurvatureJumpsBySigmaKa
                 }
             }
         }
+        std::printf("%s jump: max |[p] - sigma kappa| = %.3e Pa of %.3f Pa\n",
+                    mode == FluidMode::two_phase ? "two-phase" : "free-surface", max_error,
+                    phases.sigma * kappa);
         EXPECT_LT(max_error, 1e-8 * phases.sigma * kappa)
             << (mode == FluidMode::two_phase ? "two_phase" : "free_surface");
     }
@@ -200,6 +208,9 @@ TEST_P(FluidPressureSolverTest, ProjectedVelocityIsDivergenceFreeAroundAGasBubbl
         const ProjectionResult result =
             project(grid, interface, phases, mode, 1e-3, options, pressure);
         ASSERT_TRUE(result.solve.converged);
+        std::printf("%s divergence: max |div u| %.3e -> %.3e 1/s in %d iterations\n",
+                    mode == FluidMode::two_phase ? "two-phase" : "free-surface", before,
+                    result.max_divergence, result.solve.iterations);
         EXPECT_LT(result.max_divergence, 1e-6 * before)
             << "before " << before << " after " << result.max_divergence;
     }
