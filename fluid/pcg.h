@@ -17,12 +17,6 @@ public:
     virtual void apply(const std::vector<double>& r, std::vector<double>& z) const = 0;
 };
 
-/// Identity preconditioner (plain CG), for comparison.
-class IdentityPreconditioner final : public Preconditioner {
-public:
-    void apply(const std::vector<double>& r, std::vector<double>& z) const override { z = r; }
-};
-
 /// Solves A x = b by PCG starting from x = 0 (x is overwritten, size A.size()).
 ///
 /// When `singular` is true A is taken to be a pure-Neumann operator whose null space is the
