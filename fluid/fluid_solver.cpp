@@ -61,8 +61,8 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
     // Viscosity before gravity: the body force is then balanced by the pressure of the same
     // projection, so a fluid at rest in hydrostatic equilibrium stays exactly at rest.
     start = Clock::now();
-    result.viscosity = apply_viscosity(m_grid, interface, m_options.phases, m_options.mode,
-                                       m_options.walls, dt, m_options.viscosity);
+    result.viscosity = m_viscosity.solve(m_grid, interface, m_options.phases, m_options.mode,
+                                         m_options.walls, dt, m_options.viscosity);
     result.timings.viscosity = seconds_since(start);
 
     start = Clock::now();

@@ -82,6 +82,7 @@ private:
     FluidOptions m_options;
     MacGrid m_grid;
     Array3<double> m_pressure;
+    ViscositySolver m_viscosity;
 };
 
 }  // namespace meniscus::fluid

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -30,9 +31,12 @@ using Index3 = std::array<int, 3>;
 /// passes: diagonal stresses at cells, shear stresses on edges, their divergence on faces.
 class ViscousOperator {
 public:
-    ViscousOperator(const MacGrid& grid, const Array3<double>& phi, const PhaseOptions& phases,
-                    FluidMode mode, const WallOptions& walls, double dt)
-        : m_n{grid.nx(), grid.ny(), grid.nz()}, m_dx(grid.dx()), m_dt(dt) {
+    /// (Re)builds the operator for a grid, interface and time step, reusing the arrays' memory.
+    void build(const MacGrid& grid, const Array3<double>& phi, const PhaseOptions& phases,
+               FluidMode mode, const WallOptions& walls, double dt) {
+        m_n = {grid.nx(), grid.ny(), grid.nz()};
+        m_dx = grid.dx();
+        m_dt = dt;
         std::size_t offset = 0;
         for (int a = 0; a < 3; ++a) {
             m_face_dims[a] = m_n;
@@ -52,7 +56,7 @@ public:
             m_mu[c] = is_liquid(phi[c]) ? phases.mu_liquid : mu_gas;
         }
         set_edge_weights(walls);
-        set_faces(grid, phi, phases, mode);
+        set_faces(phi, phases, mode);
     }
 
     std::size_t size() const { return m_size; }
@@ -60,13 +64,12 @@ public:
     const std::vector<double>& density() const { return m_density; }
 
     /// Flat vector [u | v | w] of the grid's face velocities.
-    std::vector<double> gather(const MacGrid& grid) const {
-        std::vector<double> x(m_size);
+    void gather(const MacGrid& grid, std::vector<double>& x) const {
+        x.resize(m_size);
         for (int a = 0; a < 3; ++a) {
             const std::vector<double>& faces = grid.velocity(a).storage();
             std::copy(faces.begin(), faces.end(), x.begin() + m_offset[a]);
         }
-        return x;
     }
 
     void scatter(const std::vector<double>& x, MacGrid& grid) const {
@@ -77,9 +80,9 @@ public:
         }
     }
 
-    /// y = K x on every interior face (0 on wall-normal faces).
+    /// y = K x on every interior face (entries on wall-normal faces are left unspecified).
     void stiffness(const std::vector<double>& x, std::vector<double>& y) const {
-        y.assign(m_size, 0.0);
+        y.resize(m_size);
         normal_stresses(x);
         shear_stresses(x);
         stress_divergence(y);
@@ -94,8 +97,8 @@ public:
     }
 
     /// Diagonal of ρ + K on the unknowns (1 on fixed faces), for Jacobi preconditioning.
-    std::vector<double> diagonal() const {
-        std::vector<double> d(m_size, 1.0);
+    void diagonal(std::vector<double>& d) const {
+        d.assign(m_size, 1.0);
         const double inv_dx2 = 1.0 / (m_dx * m_dx);
         for (int a = 0; a < 3; ++a) {
             for_each_face(a, [&](const Index3& f, std::size_t flat) {
@@ -123,7 +126,6 @@ public:
                 d[flat] = sum;
             });
         }
-        return d;
     }
 
 private:
@@ -203,8 +205,7 @@ private:
         }
     }
 
-    void set_faces(const MacGrid& grid, const Array3<double>& phi, const PhaseOptions& phases,
-                   FluidMode mode) {
+    void set_faces(const Array3<double>& phi, const PhaseOptions& phases, FluidMode mode) {
         m_unknown.assign(m_size, 0);
         m_density.assign(m_size, 0.0);
         for (int a = 0; a < 3; ++a) {
@@ -220,7 +221,6 @@ private:
                 m_density[flat] = face_density(liquid_fraction(phi_lo, phi_hi), phases, mode);
             });
         }
-        (void)grid;
     }
 
     /// σ_a(cell) = 2Δt μ_c ∂_a x_a.
@@ -311,10 +311,10 @@ private:
         }
     }
 
-    Index3 m_n;
-    double m_dx;
-    double m_dt;
-    std::array<Index3, 3> m_face_dims;
+    Index3 m_n{};
+    double m_dx = 0.0;
+    double m_dt = 0.0;
+    std::array<Index3, 3> m_face_dims{};
     std::array<std::size_t, 3> m_offset{};
     std::size_t m_size = 0;
     Array3<double> m_mu;                          ///< μ per cell
@@ -331,9 +331,21 @@ void ViscosityOptions::validate() const {
     iteration.validate();
 }
 
-SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
-                            const PhaseOptions& phases, FluidMode mode, const WallOptions& walls,
-                            double dt, const ViscosityOptions& options) {
+/// Work arrays kept between ViscositySolver::solve calls.
+struct ViscositySolver::Workspace {
+    ViscousOperator op;
+    std::vector<double> u_star, fixed, x, b, r, z, p, q, diagonal;
+};
+
+ViscositySolver::ViscositySolver() : m_workspace(std::make_unique<Workspace>()) {}
+ViscositySolver::~ViscositySolver() = default;
+ViscositySolver::ViscositySolver(ViscositySolver&&) noexcept = default;
+ViscositySolver& ViscositySolver::operator=(ViscositySolver&&) noexcept = default;
+
+SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interface,
+                                   const PhaseOptions& phases, FluidMode mode,
+                                   const WallOptions& walls, double dt,
+                                   const ViscosityOptions& options) {
     options.validate();
     walls.validate();
     interface.validate(grid);
@@ -346,18 +358,25 @@ SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
         result.converged = true;
         return result;
     }
-    const ViscousOperator op(grid, interface.phi, phases, mode, walls, dt);
+    Workspace& ws = *m_workspace;
+    ViscousOperator& op = ws.op;
+    op.build(grid, interface.phi, phases, mode, walls, dt);
     const std::vector<char>& unknown = op.unknown();
+    const std::vector<double>& density = op.density();
     const std::size_t n = op.size();
+    std::vector<double>& x = ws.x;
+    std::vector<double>& fixed = ws.fixed;
+    std::vector<double>& b = ws.b;
     // Split u* into the unknowns x (initial guess) and the fixed faces; b = ρ u* − K u_fixed.
-    const std::vector<double> u_star = op.gather(grid);
-    std::vector<double> fixed(n, 0.0), x(n, 0.0), b(n, 0.0);
+    op.gather(grid, ws.u_star);
+    x.assign(n, 0.0);
+    fixed.assign(n, 0.0);
     for (std::size_t f = 0; f < n; ++f) {
-        (unknown[f] ? x[f] : fixed[f]) = u_star[f];
+        (unknown[f] ? x[f] : fixed[f]) = ws.u_star[f];
     }
     op.stiffness(fixed, b);
     for (std::size_t f = 0; f < n; ++f) {
-        b[f] = unknown[f] ? op.density()[f] * u_star[f] - b[f] : 0.0;
+        b[f] = unknown[f] ? density[f] * ws.u_star[f] - b[f] : 0.0;
     }
     const double b_norm = std::sqrt(dot(b, b));
     if (b_norm == 0.0) {
@@ -365,8 +384,14 @@ SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
         result.converged = true;
     } else {
         // Jacobi-preconditioned CG from the initial guess u*.
-        const std::vector<double> diagonal = op.diagonal();
-        std::vector<double> r(n), z(n), p(n), q(n);
+        std::vector<double>& r = ws.r;
+        std::vector<double>& z = ws.z;
+        std::vector<double>& p = ws.p;
+        std::vector<double>& q = ws.q;
+        op.diagonal(ws.diagonal);
+        const std::vector<double>& diagonal = ws.diagonal;
+        r.resize(n);
+        z.resize(n);
         op.apply(x, q);
         for (std::size_t f = 0; f < n; ++f) {
             r[f] = b[f] - q[f];
@@ -401,6 +426,13 @@ SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
     }
     op.scatter(x, grid);
     return result;
+}
+
+SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
+                            const PhaseOptions& phases, FluidMode mode, const WallOptions& walls,
+                            double dt, const ViscosityOptions& options) {
+    ViscositySolver solver;
+    return solver.solve(grid, interface, phases, mode, walls, dt, options);
 }
 
 }  // namespace meniscus::fluid

@@ -19,6 +19,8 @@
 /// vanishes, so the edge terms lying on that wall are dropped. In free_surface mode only
 /// faces next to a liquid cell are unknowns and the gas has μ = 0 (traction-free surface).
 
+#include <memory>
+
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
 #include "fluid/phases.h"
@@ -38,9 +40,29 @@ struct ViscosityOptions {
 /// Replaces the face velocities of `grid` (u*) by the backward-Euler viscous update over `dt`
 /// seconds. Returns the CG outcome (converged with 0 iterations when there is nothing to solve:
 /// disabled, or μ = 0 everywhere). Throws std::invalid_argument when `interface` does not fit the
-/// grid or dt ≤ 0.
+/// grid or dt ≤ 0. Allocates its work arrays on every call; see ViscositySolver to reuse them.
 SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
                             const PhaseOptions& phases, FluidMode mode, const WallOptions& walls,
                             double dt, const ViscosityOptions& options);
+
+/// The same solve as apply_viscosity(), keeping its work arrays (operator coefficients, CG
+/// vectors) between calls so repeated steps on one grid do not reallocate. Movable, not copyable;
+/// one object must not be used from two threads at once.
+class ViscositySolver {
+public:
+    ViscositySolver();
+    ~ViscositySolver();
+    ViscositySolver(ViscositySolver&&) noexcept;
+    ViscositySolver& operator=(ViscositySolver&&) noexcept;
+
+    /// See apply_viscosity().
+    SolveResult solve(MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,
+                      FluidMode mode, const WallOptions& walls, double dt,
+                      const ViscosityOptions& options);
+
+private:
+    struct Workspace;
+    std::unique_ptr<Workspace> m_workspace;
+};
 
 }  // namespace meniscus::fluid
