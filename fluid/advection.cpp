@@ -16,9 +16,9 @@ constexpr double HALF = 0.5;
 Eigen::Vector3d grid_velocity(const std::array<const Array3<double>*, 3>& velocity,
                               const Eigen::Vector3d& g, double inverse_dx) {
     return inverse_dx *
-           Eigen::Vector3d(sample_trilinear(*velocity[0], FieldLocation::x_face, g).value,
-                           sample_trilinear(*velocity[1], FieldLocation::y_face, g).value,
-                           sample_trilinear(*velocity[2], FieldLocation::z_face, g).value);
+           Eigen::Vector3d(interpolate_trilinear(*velocity[0], FieldLocation::x_face, g),
+                           interpolate_trilinear(*velocity[1], FieldLocation::y_face, g),
+                           interpolate_trilinear(*velocity[2], FieldLocation::z_face, g));
 }
 
 /// Is sample (i, j, k) of a field at `location` on a wall-normal face (kept fixed)?
@@ -60,11 +60,13 @@ void semi_lagrangian(const std::array<const Array3<double>*, 3>& velocity, doubl
                         start - HALF * dt * grid_velocity(velocity, start, inverse_dx);
                     const Eigen::Vector3d departure =
                         start - dt * grid_velocity(velocity, mid, inverse_dx);
-                    const TrilinearSample sample = sample_trilinear(in, location, departure);
-                    out[c] = sample.value;
                     if (lower != nullptr) {
+                        const TrilinearSample sample = sample_trilinear(in, location, departure);
+                        out[c] = sample.value;
                         (*lower)[c] = sample.min;
                         (*upper)[c] = sample.max;
+                    } else {
+                        out[c] = interpolate_trilinear(in, location, departure);
                     }
                 }
             }

@@ -91,33 +91,62 @@ FieldLocation face_location(int axis) {
     }
 }
 
-TrilinearSample sample_trilinear(const Array3<double>& field, FieldLocation location,
-                                 const Eigen::Vector3d& grid_position) {
+namespace {
+
+/// The 8 samples around a point and its fractional position between them.
+struct Stencil {
+    double c[8];  ///< (x, y, z) corners in the order 000, 100, 010, 110, 001, 101, 011, 111
+    double fx, fy, fz;
+};
+
+Stencil gather_stencil(const Array3<double>& field, FieldLocation location,
+                       const Eigen::Vector3d& grid_position) {
     const Eigen::Vector3d s = grid_position - field_offset(location);
     int i0, j0, k0;
-    double fx, fy, fz;
-    split_coordinate(s.x(), field.ni(), i0, fx);
-    split_coordinate(s.y(), field.nj(), j0, fy);
-    split_coordinate(s.z(), field.nk(), k0, fz);
-    const int di = field.ni() > 1 ? 1 : 0;
+    Stencil st;
+    split_coordinate(s.x(), field.ni(), i0, st.fx);
+    split_coordinate(s.y(), field.nj(), j0, st.fy);
+    split_coordinate(s.z(), field.nk(), k0, st.fz);
+    const std::size_t di = field.ni() > 1 ? 1 : 0;
     const std::size_t dj = field.nj() > 1 ? static_cast<std::size_t>(field.ni()) : 0;
     const std::size_t dk = field.nk() > 1 ? static_cast<std::size_t>(field.ni()) * field.nj() : 0;
     const std::size_t base = field.index(i0, j0, k0);
     const double* f = field.data();
-    const double c000 = f[base], c100 = f[base + di];
-    const double c010 = f[base + dj], c110 = f[base + dj + di];
-    const double c001 = f[base + dk], c101 = f[base + dk + di];
-    const double c011 = f[base + dk + dj], c111 = f[base + dk + dj + di];
-    const double c00 = c000 + fx * (c100 - c000);
-    const double c10 = c010 + fx * (c110 - c010);
-    const double c01 = c001 + fx * (c101 - c001);
-    const double c11 = c011 + fx * (c111 - c011);
-    const double c0 = c00 + fy * (c10 - c00);
-    const double c1 = c01 + fy * (c11 - c01);
+    st.c[0] = f[base];
+    st.c[1] = f[base + di];
+    st.c[2] = f[base + dj];
+    st.c[3] = f[base + dj + di];
+    st.c[4] = f[base + dk];
+    st.c[5] = f[base + dk + di];
+    st.c[6] = f[base + dk + dj];
+    st.c[7] = f[base + dk + dj + di];
+    return st;
+}
+
+double blend(const Stencil& st) {
+    const double c00 = st.c[0] + st.fx * (st.c[1] - st.c[0]);
+    const double c10 = st.c[2] + st.fx * (st.c[3] - st.c[2]);
+    const double c01 = st.c[4] + st.fx * (st.c[5] - st.c[4]);
+    const double c11 = st.c[6] + st.fx * (st.c[7] - st.c[6]);
+    const double c0 = c00 + st.fy * (c10 - c00);
+    const double c1 = c01 + st.fy * (c11 - c01);
+    return c0 + st.fz * (c1 - c0);
+}
+
+}  // namespace
+
+double interpolate_trilinear(const Array3<double>& field, FieldLocation location,
+                             const Eigen::Vector3d& grid_position) {
+    return blend(gather_stencil(field, location, grid_position));
+}
+
+TrilinearSample sample_trilinear(const Array3<double>& field, FieldLocation location,
+                                 const Eigen::Vector3d& grid_position) {
+    const Stencil st = gather_stencil(field, location, grid_position);
     TrilinearSample sample;
-    sample.value = c0 + fz * (c1 - c0);
-    sample.min = std::min({c000, c100, c010, c110, c001, c101, c011, c111});
-    sample.max = std::max({c000, c100, c010, c110, c001, c101, c011, c111});
+    sample.value = blend(st);
+    sample.min = *std::min_element(st.c, st.c + 8);
+    sample.max = *std::max_element(st.c, st.c + 8);
     return sample;
 }
 
@@ -146,14 +175,14 @@ Eigen::Vector3d MacGrid::face_centre(int axis, int i, int j, int k) const {
 }
 
 double MacGrid::sample_component(int axis, const Eigen::Vector3d& x) const {
-    return sample_trilinear(m_velocity[axis], face_location(axis), to_grid(x)).value;
+    return interpolate_trilinear(m_velocity[axis], face_location(axis), to_grid(x));
 }
 
 Eigen::Vector3d MacGrid::sample_velocity(const Eigen::Vector3d& x) const {
     const Eigen::Vector3d g = to_grid(x);
-    return {sample_trilinear(m_velocity[0], FieldLocation::x_face, g).value,
-            sample_trilinear(m_velocity[1], FieldLocation::y_face, g).value,
-            sample_trilinear(m_velocity[2], FieldLocation::z_face, g).value};
+    return {interpolate_trilinear(m_velocity[0], FieldLocation::x_face, g),
+            interpolate_trilinear(m_velocity[1], FieldLocation::y_face, g),
+            interpolate_trilinear(m_velocity[2], FieldLocation::z_face, g)};
 }
 
 double MacGrid::divergence(int i, int j, int k) const {

@@ -68,6 +68,10 @@ struct TrilinearSample {
 TrilinearSample sample_trilinear(const Array3<double>& field, FieldLocation location,
                                  const Eigen::Vector3d& grid_position);
 
+/// The value of sample_trilinear() alone (cheaper: no stencil bounds).
+double interpolate_trilinear(const Array3<double>& field, FieldLocation location,
+                             const Eigen::Vector3d& grid_position);
+
 /// Staggered MAC grid holding the face velocities (m/s). See the file comment for the layout.
 class MacGrid {
 public:
