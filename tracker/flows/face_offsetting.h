@@ -1,0 +1,144 @@
+#pragma once
+/// \file Motion in the normal direction by face offsetting (Jiao 2007; paper §4.1).
+///
+/// Each triangle plane moves along its unit normal by hᵢ = speedᵢ·Δt. Each vertex then takes
+/// the displacement d that best fits its incident offset planes, nᵢ·d = hᵢ, in the weighted
+/// least-squares sense, using the eigen-decomposition of
+///
+///     A = Σᵢ wᵢ nᵢ nᵢᵀ,   b = Σᵢ wᵢ hᵢ nᵢ,   A = Σₖ λₖ eₖ eₖᵀ (λ₁ ≥ λ₂ ≥ λ₃ ≥ 0).
+///
+/// The primary space is spanned by the eₖ with λₖ ≥ ε·λ₁ (ε = `primary_eigenvalue_ratio`):
+/// the displacement there is Σ_primary (eₖ·b / λₖ) eₖ, i.e. the least-squares offset restricted
+/// to the directions the planes determine (1 on a smooth patch, 2 on a ridge, 3 at a corner).
+/// The null space (the other eₖ, tangential directions) gets an optional tangential smoothing
+/// move and otherwise no motion. Where offset planes converge (a shock: concave crease moving
+/// outward, convex crease moving inward) the vertex lands on the planes' intersection, which
+/// is the entropy solution that vertex-normal motion misses. At a crease that opens up (an
+/// expansion fan) the same rule keeps the crease sharp (its vertex on both offset planes); the
+/// exact solution is a rounded fan there, which mesh refinement must resolve.
+///
+/// Weights wᵢ: triangle areas (default) or the triangle's interior angle at the vertex.
+///
+/// Convention: a triangle's normal is (b − a) × (c − a) normalized (outward for the meshes the
+/// mesher builds); positive speed moves the surface along it.
+
+#include "tracker/mesh.h"
+
+#include <array>
+#include <vector>
+
+namespace meniscus::tracker {
+
+/// Weights wᵢ of the incident triangles in A = Σ wᵢ nᵢ nᵢᵀ.
+enum class OffsetWeighting {
+    area,   ///< triangle area (m²)
+    angle,  ///< interior angle of the triangle at the vertex (radians)
+};
+
+/// Options of face_offset_displacements().
+struct FaceOffsettingOptions {
+    OffsetWeighting weighting = OffsetWeighting::area;
+    /// Eigenvalues λₖ ≥ ratio·λ₁ of A form the primary space (Jiao's threshold ε); in (0, 1).
+    double primary_eigenvalue_ratio = 0.003;
+    /// Fraction in [0, 1] of the null-space projection of (area-weighted mean of the incident
+    /// triangle centroids − vertex) added as tangential smoothing; 0 (default) leaves the null
+    /// space still, so displacements are exactly linear in Δt and the tracker's own null-space
+    /// smoothing improves the mesh between steps.
+    double null_space_smoothing = 0.0;
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// Result of face_offset_displacements().
+struct FaceOffset {
+    /// Per vertex slot (zero for dead vertices and vertices without live triangles), metres.
+    std::vector<Vec3> displacements;
+    /// Per vertex slot: dimension of the primary space (1 smooth, 2 ridge, 3 corner; 0 for dead
+    /// or isolated vertices).
+    std::vector<int> primary_rank;
+};
+
+/// Face-offsetting displacements over one step of length `dt` (s) with per-triangle normal
+/// speeds `triangle_speeds` (m/s, sized num_triangles(); dead slots ignored).
+/// Degenerate triangles (area below 1e-14 of the squared longest edge) carry no plane.
+/// Throws std::invalid_argument on a size mismatch, non-finite dt or invalid options.
+FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
+                                     const std::vector<double>& triangle_speeds, double dt,
+                                     const FaceOffsettingOptions& options = {});
+
+/// Same with one speed (m/s) for every triangle.
+FaceOffset face_offset_displacements(const SurfaceMesh& mesh, double speed, double dt,
+                                     const FaceOffsettingOptions& options = {});
+
+/// Options of the step limit that keeps triangles from inverting.
+struct InversionLimitOptions {
+    /// Every live triangle must keep at least this fraction of its signed area measured along
+    /// its normal at the start of the step; in [0, 1). 0 only forbids inversion itself; the
+    /// default leaves a margin so that no triangle becomes exactly degenerate.
+    double min_area_fraction = 0.1;
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// Largest τ in [0, 1] such that, moving every vertex along x + τ'·d for τ' in [0, τ], each live
+/// triangle's area vector dotted with its unit normal at τ' = 0 stays ≥ min_area_fraction times
+/// its area at τ' = 0. Per triangle this is a quadratic in τ', solved in closed form. Triangles
+/// already degenerate at τ' = 0 (area below 1e-14 of the squared longest edge) are ignored.
+/// For face offsetting with null_space_smoothing = 0, displacements are linear in Δt, so the
+/// shortened step is exactly τ·Δt. Throws std::invalid_argument if `displacements` is not
+/// sized num_vertices().
+double max_non_inverting_step_fraction(const SurfaceMesh& mesh,
+                                       const std::vector<Vec3>& displacements,
+                                       const InversionLimitOptions& options = {});
+
+/// One face-offsetting step with the inversion limit applied (paper §4.1: "we adjust the time
+/// step to avoid inverting any triangles over a single offsetting step").
+struct FaceOffsetStep {
+    std::vector<Vec3> displacements;  ///< for the step actually taken (metres)
+    double dt = 0.0;                  ///< step actually taken (s), ≤ the requested one
+    bool shortened = false;           ///< true if dt < the requested step
+    int attempts = 0;                 ///< displacement evaluations (1 unless shortened)
+};
+
+/// Computes displacements for `dt_max` and shortens the step to the inversion limit. With
+/// null_space_smoothing = 0 displacements are linear in Δt, so they are scaled by the limit
+/// fraction τ (dt = τ·dt_max, one evaluation). With smoothing they are recomputed and checked
+/// again, halving further on failure, at most `MAX_STEP_ATTEMPTS` evaluations (then the last
+/// ones are scaled back, which is inversion-free along straight lines).
+/// Throws std::invalid_argument on invalid options or dt_max ≤ 0.
+FaceOffsetStep face_offset_step(const SurfaceMesh& mesh, const std::vector<double>& triangle_speeds,
+                                double dt_max, const FaceOffsettingOptions& offsetting = {},
+                                const InversionLimitOptions& inversion = {});
+
+/// Bound on the displacement evaluations in face_offset_step().
+constexpr int MAX_STEP_ATTEMPTS = 16;
+
+/// Remeshing guard for face-offsetting runs (paper §4.1: "we reject any edge collapse or edge
+/// flip operation that results in a triangle with a normal that is too different from the
+/// original triangle normals").
+struct NormalTurnLimit {
+    /// Largest allowed angle (degrees, in (0, 180)) between a new triangle's normal and the
+    /// reference normal of the triangles it replaces.
+    double max_angle_degrees = 30.0;
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// True if triangle (a, b, c) — oriented, normal (b − a) × (c − a) — turns its normal by more
+/// than `limit` away from `reference_normal` (any length > 0), or is degenerate (area below
+/// 1e-14 of its squared longest edge). Throws std::invalid_argument on a zero reference.
+bool triangle_normal_turn_too_large(const Vec3& reference_normal, const Vec3& a, const Vec3& b,
+                                    const Vec3& c, const NormalTurnLimit& limit = {});
+
+/// Positions of an oriented triangle's three corners.
+using TriangleCorners = std::array<Vec3, 3>;
+
+/// For a remeshing operation that replaces `old_triangles` by `new_triangles` (positions after
+/// the operation, same orientation convention): true if any new triangle turns its normal too
+/// far from the area-weighted mean normal of the old ones (see triangle_normal_turn_too_large).
+/// Edge flip: the two triangles on the edge before and after. Edge collapse: the triangles
+/// around both endpoints before, the surviving rewired triangles after. Returns true (refuse)
+/// if the old triangles have no mean normal (they cancel). Throws std::invalid_argument if
+/// `old_triangles` is empty.
+bool operation_turns_normals_too_far(const std::vector<TriangleCorners>& old_triangles,
+                                     const std::vector<TriangleCorners>& new_triangles,
+                                     const NormalTurnLimit& limit = {});
+
+}  // namespace meniscus::tracker

@@ -1,0 +1,121 @@
+#include "tracker/flows/mean_curvature.h"
+
+#include "tracker/flows/vertex_normal_motion.h"
+#include "tracker/mesh_measures.h"
+
+#include <array>
+#include <stdexcept>
+#include <string>
+
+namespace meniscus::tracker {
+
+namespace {
+
+/// cot of the angle between u and v. A degenerate corner (|u × v| = 0) contributes nothing.
+double cotangent(const Vec3& u, const Vec3& v) {
+    const double sine = u.cross(v).norm();
+    return sine > 0.0 ? u.dot(v) / sine : 0.0;
+}
+
+/// Per-triangle cotangent accumulation and mixed areas for every vertex slot.
+struct CotangentSums {
+    std::vector<Vec3> laplacian_sum;  ///< Σⱼ (cot αᵢⱼ + cot βᵢⱼ)(xᵢ − xⱼ) per vertex
+    std::vector<double> mixed_area;
+};
+
+CotangentSums accumulate(const SurfaceMesh& mesh) {
+    const size_t nv = static_cast<size_t>(mesh.num_vertices());
+    CotangentSums sums{std::vector<Vec3>(nv, Vec3::Zero()), std::vector<double>(nv, 0.0)};
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti))
+            continue;
+        const Triangle& t = mesh.triangle(ti);
+        const std::array<Vec3, 3> p = {mesh.position(t[0]), mesh.position(t[1]),
+                                       mesh.position(t[2])};
+        const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+        std::array<double, 3> cot{};
+        int obtuse_corner = -1;
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
+            cot[static_cast<size_t>(k)] = cotangent(u, v);
+            if (u.dot(v) < 0.0)
+                obtuse_corner = k;
+        }
+        for (int k = 0; k < 3; ++k) {
+            // Edge (i, j) opposite corner k, weighted by cot of that corner.
+            const int i = (k + 1) % 3, j = (k + 2) % 3;
+            const Vec3 e = p[static_cast<size_t>(i)] - p[static_cast<size_t>(j)];
+            const double w = cot[static_cast<size_t>(k)];
+            sums.laplacian_sum[static_cast<size_t>(t[static_cast<size_t>(i)])] += w * e;
+            sums.laplacian_sum[static_cast<size_t>(t[static_cast<size_t>(j)])] -= w * e;
+        }
+        for (int k = 0; k < 3; ++k) {
+            double a;
+            if (obtuse_corner < 0) {
+                // Voronoi area at corner k: (1/8)(|e_ki|² cot j + |e_kj|² cot i).
+                const int i = (k + 1) % 3, j = (k + 2) % 3;
+                const double len_ki =
+                    (p[static_cast<size_t>(i)] - p[static_cast<size_t>(k)]).squaredNorm();
+                const double len_kj =
+                    (p[static_cast<size_t>(j)] - p[static_cast<size_t>(k)]).squaredNorm();
+                a = 0.125 *
+                    (len_ki * cot[static_cast<size_t>(j)] + len_kj * cot[static_cast<size_t>(i)]);
+            } else {
+                a = k == obtuse_corner ? 0.5 * area : 0.25 * area;
+            }
+            sums.mixed_area[static_cast<size_t>(t[static_cast<size_t>(k)])] += a;
+        }
+    }
+    return sums;
+}
+
+}  // namespace
+
+std::vector<double> mixed_voronoi_areas(const SurfaceMesh& mesh) {
+    return accumulate(mesh).mixed_area;
+}
+
+std::vector<Vec3> mean_curvature_normals(const SurfaceMesh& mesh) {
+    const CotangentSums sums = accumulate(mesh);
+    std::vector<Vec3> k(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        const size_t i = static_cast<size_t>(vi);
+        if (!mesh.vertex_alive(vi) || !(sums.mixed_area[i] > 0.0) || mesh.is_boundary_vertex(vi))
+            continue;
+        // K = (1 / 2A) Σ (cot α + cot β)(xᵢ − xⱼ); the per-triangle sum holds Σ cot·(xᵢ − xⱼ).
+        k[i] = sums.laplacian_sum[i] / (2.0 * sums.mixed_area[i]);
+    }
+    return k;
+}
+
+std::vector<double> mean_curvatures(const SurfaceMesh& mesh) {
+    const std::vector<Vec3> k = mean_curvature_normals(mesh);
+    const std::vector<Vec3> n = area_weighted_vertex_normals(mesh);
+    std::vector<double> kappa(k.size(), 0.0);
+    for (size_t i = 0; i < k.size(); ++i)
+        kappa[i] = k[i].dot(n[i]);
+    return kappa;
+}
+
+void MeanCurvatureFlowOptions::validate() const {
+    if (!(cfl_number > 0.0 && cfl_number <= 1.0))
+        throw std::invalid_argument("cfl_number: expected a number in (0, 1], got " +
+                                    std::to_string(cfl_number));
+}
+
+double mean_curvature_time_step(const SurfaceMesh& mesh, const MeanCurvatureFlowOptions& options) {
+    options.validate();
+    const EdgeLengthStats stats = edge_length_stats(mesh);
+    if (stats.count == 0)
+        throw std::invalid_argument("mesh: expected at least one live edge");
+    return options.cfl_number * stats.min * stats.min;
+}
+
+std::vector<Vec3> mean_curvature_displacements(const SurfaceMesh& mesh, double dt) {
+    std::vector<Vec3> d = mean_curvature_normals(mesh);
+    for (Vec3& v : d)
+        v *= -dt;
+    return d;
+}
+
+}  // namespace meniscus::tracker

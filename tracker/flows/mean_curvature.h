@@ -1,0 +1,58 @@
+#pragma once
+/// \file Motion by mean curvature (paper §4.2) with the discrete operators of Meyer, Desbrun,
+/// Schröder and Barr 2003 ("Discrete differential-geometry operators for triangulated
+/// 2-manifolds"): cotangent weights and mixed Voronoi areas.
+///
+/// Conventions (shared with coupling/ for surface tension):
+/// - κ is the *sum* of the principal curvatures (2/R for a sphere of radius R), in 1/m;
+/// - the curvature normal is K(xᵢ) = (1 / (2 A_mixed,i)) Σⱼ (cot αᵢⱼ + cot βᵢⱼ) (xᵢ − xⱼ)
+///   = κ n, with n the outward normal (so K points out of a sphere and |K| = 2/R);
+/// - mean-curvature flow moves the surface with velocity −K = −κ n (a sphere shrinks with
+///   R(t) = sqrt(R₀² − 4t));
+/// - the signed scalar κᵢ = K(xᵢ) · nᵢ with nᵢ the area-weighted vertex normal: κ > 0 on a
+///   convex closed surface with outward normals.
+///
+/// Boundary vertices of open surfaces (§4.4) have no closed one-ring: their K and κ are zero
+/// (they are held fixed by the flow). Non-manifold edges contribute the cotangents of every
+/// incident triangle.
+
+#include "tracker/mesh.h"
+
+#include <vector>
+
+namespace meniscus::tracker {
+
+/// Mixed Voronoi area of each vertex (Meyer et al. 2003, Fig. 4): per incident triangle, the
+/// Voronoi region area (1/8)(|pr|² cot q + |pq|² cot r) if the triangle is not obtuse, else
+/// area/2 at the obtuse corner and area/4 at the two others. Units m²; zero for dead vertices.
+/// The areas of all vertices sum to the mesh area.
+std::vector<double> mixed_voronoi_areas(const SurfaceMesh& mesh);
+
+/// Curvature normal K = κ n at each vertex (1/m; see the file comment). Zero for dead,
+/// isolated and boundary vertices.
+std::vector<Vec3> mean_curvature_normals(const SurfaceMesh& mesh);
+
+/// Signed mean curvature κ (sum of principal curvatures, 1/m) at each vertex: K · n with n the
+/// area-weighted vertex normal. Zero for dead, isolated and boundary vertices.
+std::vector<double> mean_curvatures(const SurfaceMesh& mesh);
+
+/// Options of mean-curvature flow.
+struct MeanCurvatureFlowOptions {
+    /// Forward-Euler step limit Δt ≤ cfl_number · (shortest live edge)². The explicit cotangent
+    /// Laplacian on an equilateral mesh is stable up to ℓ²/3; 0.1 leaves room for irregular
+    /// triangles. In (0, 1].
+    double cfl_number = 0.1;
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// The CFL-limited forward-Euler step cfl_number · ℓ_min² (s, with unit diffusion coefficient:
+/// the flow speed is κ in m/s). Throws std::invalid_argument on invalid options or a mesh
+/// without live edges.
+double mean_curvature_time_step(const SurfaceMesh& mesh,
+                                const MeanCurvatureFlowOptions& options = {});
+
+/// Forward-Euler displacements −K(xᵢ)·dt (m) for a step `dt` (s). Zero for dead and boundary
+/// vertices. Sized num_vertices().
+std::vector<Vec3> mean_curvature_displacements(const SurfaceMesh& mesh, double dt);
+
+}  // namespace meniscus::tracker
