@@ -1,0 +1,279 @@
+/// Remeshing operations (paper §3.5, §3.6.1) on every mesh in tests/data/: after each pass the
+/// mesh is admissible and intersection-free (exact check); splits leave no long manifold edge;
+/// collapses and flips change the volume by at most γ each; the open boundary never changes.
+
+#include "remesh_test_meshes.h"
+
+#include "tracker/mesh_intersections.h"
+#include "tracker/mesh_io.h"
+#include "tracker/mesh_measures.h"
+#include "tracker/mesh_validate.h"
+#include "tracker/quadric.h"
+#include "tracker/remesh/butterfly.h"
+#include "tracker/remesh/improve.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+namespace meniscus::tracker {
+namespace {
+
+using testing::NamedMesh;
+
+std::string violations_text(const std::vector<MeshViolation>& v) {
+    std::string s;
+    for (const MeshViolation& m : v)
+        s += m.message + "; ";
+    return s;
+}
+
+void expect_admissible(const NamedMesh& m, const char* after) {
+    ValidationOptions vo;
+    vo.allow_boundary = m.open;
+    const auto violations = validate_mesh(m.mesh, vo);
+    EXPECT_TRUE(violations.empty())
+        << m.name << " after " << after << ": " << violations_text(violations);
+    EXPECT_TRUE(is_intersection_free(m.mesh)) << m.name << " intersects after " << after;
+}
+
+/// Boundary edges as position pairs (vertex indices change under remeshing).
+std::set<std::array<double, 6>> boundary_signature(const SurfaceMesh& mesh) {
+    std::set<std::array<double, 6>> out;
+    for (int ei = 0; ei < mesh.num_edges(); ++ei) {
+        if (!mesh.edge_alive(ei) || !mesh.is_boundary_edge(ei))
+            continue;
+        Vec3 a = mesh.position(mesh.edge(ei)[0]), b = mesh.position(mesh.edge(ei)[1]);
+        if (std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3))
+            std::swap(a, b);
+        out.insert({a.x(), a.y(), a.z(), b.x(), b.y(), b.z()});
+    }
+    return out;
+}
+
+/// Records the enclosed volume change of every single collapse.
+class VolumeWatcher : public MeshObserver {
+public:
+    explicit VolumeWatcher(const SurfaceMesh& mesh) : m_mesh(mesh), m_last(enclosed_volume(mesh)) {}
+    void on_edge_collapse(int, int, double) override {
+        const double v = enclosed_volume(m_mesh);
+        max_change = std::max(max_change, std::abs(v - m_last));
+        m_last = v;
+        ++collapses;
+    }
+    double max_change = 0.0;
+    int collapses = 0;
+
+private:
+    const SurfaceMesh& m_mesh;
+    double m_last;
+};
+
+class RemeshOnTestData : public ::testing::TestWithParam<std::string> {
+protected:
+    NamedMesh load() const {
+        for (NamedMesh& m : testing::load_test_meshes())
+            if (m.name == GetParam())
+                return std::move(m);
+        ADD_FAILURE() << "no mesh " << GetParam();
+        return {};
+    }
+};
+
+std::vector<std::string> test_mesh_names() {
+    std::vector<std::string> names;
+    for (const NamedMesh& m : testing::load_test_meshes())
+        names.push_back(m.name);
+    return names;
+}
+
+TEST_P(RemeshOnTestData, EveryPassKeepsTheMeshValidAndIntersectionFree) {
+    NamedMesh m = load();
+    expect_admissible(m, "loading");
+    const auto boundary = boundary_signature(m.mesh);
+    const double xi0 = testing::mean_edge_length(m.mesh);
+    RemeshOptions options;
+    ImproveContext context;
+    context.allow_topology_changes = false;
+
+    // A finer target forces splits.
+    context.xi = 0.6 * xi0;
+    const RemeshLimits fine = remesh_limits(options, context.xi);
+    const SplitReport split = split_long_edges(m.mesh, options, context);
+    EXPECT_GT(split.splits, 0) << m.name;
+    expect_admissible(m, "split");
+    for (int ei = 0; ei < m.mesh.num_edges(); ++ei) {
+        if (!m.mesh.edge_alive(ei) || m.mesh.edge_triangles(ei).size() != 2)
+            continue;
+        const Edge& e = m.mesh.edge(ei);
+        EXPECT_LE((m.mesh.position(e[0]) - m.mesh.position(e[1])).norm(), fine.max_edge_length)
+            << m.name << ": a manifold edge is still long after splitting";
+    }
+
+    const double volume_before_flips = enclosed_volume(m.mesh);
+    const FlipReport flip = flip_edges(m.mesh, options, context);
+    expect_admissible(m, "flip");
+    EXPECT_LE(std::abs(enclosed_volume(m.mesh) - volume_before_flips),
+              flip.flips * fine.max_volume_change + 1e-12)
+        << m.name;
+    EXPECT_LE(flip.sweeps, options.max_flip_sweeps);
+
+    // A coarser target forces collapses; each one changes the volume by at most γ.
+    context.xi = 1.5 * xi0;
+    const RemeshLimits coarse = remesh_limits(options, context.xi);
+    VolumeWatcher watcher(m.mesh);
+    m.mesh.add_observer(&watcher);
+    const CollapseReport collapse = collapse_short_edges(m.mesh, options, context);
+    m.mesh.remove_observer(&watcher);
+    EXPECT_GT(collapse.collapses, 0) << m.name;
+    EXPECT_EQ(watcher.collapses, collapse.collapses);
+    if (!m.open) {
+        EXPECT_LE(watcher.max_change, coarse.max_volume_change * (1.0 + 1e-9)) << m.name;
+    }
+    expect_admissible(m, "collapse");
+
+    options.smoothing_iterations = 2;
+    const SmoothReport smooth = smooth_null_space(m.mesh, options, context);
+    EXPECT_GT(smooth.vertices_moved, 0) << m.name;
+    expect_admissible(m, "smoothing");
+
+    EXPECT_EQ(boundary_signature(m.mesh), boundary) << m.name << ": the open boundary changed";
+}
+
+TEST_P(RemeshOnTestData, ImprovementBringsEdgesIntoRangeExceptWhereRefused) {
+    NamedMesh m = load();
+    RemeshOptions options;
+    ImproveContext context;
+    context.xi = testing::mean_edge_length(m.mesh);
+    context.allow_topology_changes = false;
+    const RemeshLimits limits = remesh_limits(options, context.xi);
+    const int euler = euler_characteristic(m.mesh);
+    const int components = triangle_components(m.mesh).count;
+    ImproveReport report;
+    constexpr int STEPS = 3;
+    for (int step = 0; step < STEPS; ++step) {
+        report = improve_mesh(m.mesh, options, context);
+        expect_admissible(m, "improve_mesh");
+    }
+    int long_edges = 0, short_edges = 0;
+    for (int ei = 0; ei < m.mesh.num_edges(); ++ei) {
+        if (!m.mesh.edge_alive(ei))
+            continue;
+        const Edge& e = m.mesh.edge(ei);
+        const double length = (m.mesh.position(e[0]) - m.mesh.position(e[1])).norm();
+        const bool splittable = m.mesh.edge_triangles(ei).size() == 2;
+        if (length > limits.max_edge_length && splittable)
+            ++long_edges;
+        if (length < limits.min_edge_length && splittable && !m.mesh.is_boundary_edge(ei))
+            ++short_edges;
+    }
+    // Splits are never refused; smoothing may stretch an edge a little after the last split.
+    EXPECT_LE(long_edges, report.smooth.vertices_moved > 0 ? m.mesh.count_live_edges() / 50 : 0)
+        << m.name;
+    EXPECT_LE(short_edges, report.collapse.refused_total() + report.collapse.skipped_boundary)
+        << m.name;
+    EXPECT_EQ(euler_characteristic(m.mesh), euler) << m.name;
+    EXPECT_EQ(triangle_components(m.mesh).count, components) << m.name;
+}
+
+std::string param_name(const ::testing::TestParamInfo<std::string>& param) {
+    return param.param;
+}
+
+INSTANTIATE_TEST_SUITE_P(TestData, RemeshOnTestData, ::testing::ValuesIn(test_mesh_names()),
+                         param_name);
+
+TEST(Butterfly, ReproducesAPlaneAndNeedsAFullStencil) {
+    // A flat hexagonal patch: the butterfly point of an interior edge is its midpoint.
+    SurfaceMesh sphere = testing::make_test_sphere();
+    for (int ei = 0; ei < sphere.num_edges(); ++ei) {
+        if (!sphere.edge_alive(ei))
+            continue;
+        const auto p = butterfly_point(sphere, ei);
+        ASSERT_TRUE(p.has_value());
+        // On a sphere the butterfly point lies outside the chord midpoint (towards the surface).
+        EXPECT_GT(p->norm(), edge_midpoint(sphere, ei).norm());
+    }
+    SurfaceMesh open = testing::make_test_open_cap();
+    int missing = 0;
+    for (int ei = 0; ei < open.num_edges(); ++ei)
+        missing += open.edge_alive(ei) && open.is_boundary_edge(ei) &&
+                   !butterfly_point(open, ei).has_value();
+    EXPECT_GT(missing, 0);
+}
+
+TEST(Quadric, ClassifiesSmoothRidgeAndCorner) {
+    SurfaceMesh cubes = testing::make_test_edge_sharing_cubes();
+    const FeatureThresholds thresholds;
+    int smooth = 0, ridge = 0, corner = 0;
+    for (int vi = 0; vi < cubes.num_vertices(); ++vi) {
+        const Vec3& p = cubes.position(vi);
+        const VertexQuadric q = vertex_quadric(cubes, vi, thresholds);
+        auto on_boundary_plane = [](double c) {
+            return std::abs(c) < 1e-12 || std::abs(c - 0.4) < 1e-12 || std::abs(c - 0.8) < 1e-12;
+        };
+        const int planes =
+            on_boundary_plane(p.x()) + on_boundary_plane(p.y()) + on_boundary_plane(p.z());
+        // Vertices of the first cube only (the second shares the edge x = y = 0.4).
+        if (p.x() > 0.4 + 1e-12 || p.y() > 0.4 + 1e-12)
+            continue;
+        if (std::abs(p.x() - 0.4) < 1e-12 && std::abs(p.y() - 0.4) < 1e-12)
+            continue;
+        if (planes == 1) {
+            EXPECT_EQ(q.feature, VertexFeature::smooth);
+            ++smooth;
+        } else if (planes == 2) {
+            EXPECT_EQ(q.feature, VertexFeature::ridge);
+            ++ridge;
+            // The null space is the ridge line: the projector kills both face normals.
+            EXPECT_NEAR(q.null_space_projector().trace(), 1.0, 1e-9);
+        } else if (planes == 3) {
+            EXPECT_EQ(q.feature, VertexFeature::corner);
+            EXPECT_NEAR(q.null_space_projector().norm(), 0.0, 1e-12);
+            ++corner;
+        }
+    }
+    EXPECT_GT(smooth, 0);
+    EXPECT_GT(ridge, 0);
+    EXPECT_GT(corner, 0);
+}
+
+TEST(RemeshOptions, ValidateNamesTheField) {
+    RemeshOptions o;
+    EXPECT_NO_THROW(o.validate());
+    o.max_edge_fraction = 0.4;
+    try {
+        o.validate();
+        FAIL();
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("max_edge_fraction"), std::string::npos);
+    }
+    TopologyOptions t;
+    t.merge_distance_fraction = -1.0;
+    EXPECT_THROW(t.validate(), std::invalid_argument);
+    ImproveContext c;
+    EXPECT_THROW(c.validate(), std::invalid_argument);  // xi unset
+}
+
+TEST(RemeshSwitches, CollisionSafetyOffStillProducesAValidMesh) {
+    SurfaceMesh torus = testing::make_test_torus();
+    RemeshOptions options;
+    ImproveContext context;
+    context.xi = 0.8 * testing::mean_edge_length(torus);
+    context.collision_safety = false;
+    context.allow_topology_changes = false;
+    improve_mesh(torus, options, context);
+    EXPECT_TRUE(validate_mesh(torus).empty());
+}
+
+/// Regenerates tests/data/*.obj: run with --gtest_also_run_disabled_tests.
+TEST(RemeshTestData, DISABLED_Generate) {
+    for (const NamedMesh& m : testing::generate_test_meshes())
+        write_obj(std::string(MENISCUS_TEST_DATA_DIR) + "/" + m.name + ".obj", m.mesh);
+}
+
+}  // namespace
+}  // namespace meniscus::tracker

@@ -1,0 +1,188 @@
+/// Topology changes (paper §3.6, §3.7): touching spheres merge into one sphere-like component,
+/// a thinning dumbbell pinches into two closed components, and with topology changes off
+/// neither genus nor component count ever changes.
+
+#include "remesh_test_meshes.h"
+
+#include "tracker/mesh_intersections.h"
+#include "tracker/mesh_measures.h"
+#include "tracker/mesh_validate.h"
+#include "tracker/remesh/improve.h"
+#include "tracker/topology/change_topology.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace meniscus::tracker {
+namespace {
+
+std::string violations_text(const std::vector<MeshViolation>& v) {
+    std::string s;
+    for (const MeshViolation& m : v)
+        s += m.message + "; ";
+    return s;
+}
+
+void expect_valid(const SurfaceMesh& mesh, const char* after) {
+    const auto violations = validate_mesh(mesh);
+    EXPECT_TRUE(violations.empty()) << after << ": " << violations_text(violations);
+    EXPECT_TRUE(is_intersection_free(mesh)) << "intersects after " << after;
+}
+
+/// Squeezes the handle of an x-aligned dumbbell towards the x axis: (y, z) scaled by
+/// 1 − strength · exp(−(x/width)²). The map is injective for strength < 1, so a surface of
+/// revolution stays intersection-free.
+void squeeze_handle(SurfaceMesh& mesh, double strength, double width) {
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        if (!mesh.vertex_alive(vi))
+            continue;
+        Vec3 p = mesh.position(vi);
+        const double f = 1.0 - strength * std::exp(-(p.x() / width) * (p.x() / width));
+        p.y() *= f;
+        p.z() *= f;
+        mesh.set_position(vi, p);
+    }
+}
+
+TEST(Merge, TwoTouchingSpheresBecomeOneSphere) {
+    constexpr double RADIUS = 0.2, GAP = 0.002, EDGE = 0.05;
+    SurfaceMesh mesh = testing::make_two_spheres(RADIUS, GAP, EDGE);
+    expect_valid(mesh, "generation");
+    ASSERT_EQ(triangle_components(mesh).count, 2);
+    ASSERT_EQ(euler_characteristic(mesh), 4);
+
+    TopologyOptions options;
+    TopologyContext context;
+    context.xi = testing::mean_edge_length(mesh);
+    ASSERT_LT(GAP, options.merge_distance_fraction * context.xi);
+    const TopologyReport report = change_topology(mesh, options, context);
+    EXPECT_GE(report.merge.merges, 1);
+    expect_valid(mesh, "merging");
+    EXPECT_EQ(triangle_components(mesh).count, 1);
+    EXPECT_EQ(euler_characteristic(mesh), 2);
+
+    // Improvement afterwards keeps it one sphere-like, valid component.
+    RemeshOptions remesh;
+    ImproveContext improve;
+    improve.xi = context.xi;
+    improve_mesh(mesh, remesh, improve);
+    expect_valid(mesh, "improvement after merging");
+    EXPECT_EQ(triangle_components(mesh).count, 1);
+    EXPECT_EQ(euler_characteristic(mesh), 2);
+}
+
+TEST(Merge, FarApartSpheresDoNotMergeAndMergingOffDoesNothing) {
+    SurfaceMesh far = testing::make_two_spheres(0.2, 0.05, 0.05);
+    TopologyOptions options;
+    TopologyContext context;
+    context.xi = testing::mean_edge_length(far);
+    EXPECT_EQ(change_topology(far, options, context).merge.merges, 0);
+    SurfaceMesh near = testing::make_two_spheres(0.2, 0.002, 0.05);
+    options.allow_merging = false;
+    EXPECT_EQ(change_topology(near, options, context).merge.merges, 0);
+    EXPECT_EQ(triangle_components(near).count, 2);
+}
+
+TEST(Separation, ThinningDumbbellPinchesIntoTwoClosedComponents) {
+    SurfaceMesh mesh = testing::make_test_dumbbell();
+    RemeshOptions remesh;
+    ImproveContext improve;
+    improve.xi = testing::mean_edge_length(mesh);
+    TopologyOptions topology;
+    TopologyContext topo_context;
+    topo_context.xi = improve.xi;
+    constexpr int MAX_STEPS = 60;
+    constexpr double STRENGTH = 0.15, WIDTH = 0.12;
+    int steps = 0;
+    while (triangle_components(mesh).count < 2 && steps < MAX_STEPS) {
+        squeeze_handle(mesh, STRENGTH, WIDTH);
+        ASSERT_TRUE(is_intersection_free(mesh)) << "the squeeze itself intersected";
+        improve_mesh(mesh, remesh, improve);
+        expect_valid(mesh, "improvement");
+        change_topology(mesh, topology, topo_context);
+        expect_valid(mesh, "topology change");
+        ++steps;
+    }
+    mesh.compact();
+    const Components components = triangle_components(mesh);
+    EXPECT_EQ(components.count, 2) << "after " << steps << " steps";
+    // Two closed sphere-like pieces: χ = 2 each.
+    EXPECT_EQ(euler_characteristic(mesh), 4);
+    expect_valid(mesh, "pinch-off");
+    for (double v : component_volumes(mesh, components))
+        EXPECT_GT(v, 0.0);
+}
+
+TEST(TopologyOff, SqueezedDumbbellAndNearSpheresKeepGenusAndComponents) {
+    SurfaceMesh dumbbell = testing::make_test_dumbbell();
+    RemeshOptions remesh;
+    ImproveContext improve;
+    improve.xi = testing::mean_edge_length(dumbbell);
+    improve.allow_topology_changes = false;
+    constexpr int STEPS = 25;
+    for (int step = 0; step < STEPS; ++step) {
+        squeeze_handle(dumbbell, 0.15, 0.12);
+        if (!is_intersection_free(dumbbell))
+            break;  // the squeeze (not the remesher) would tangle a collapsed neck
+        improve_mesh(dumbbell, remesh, improve);
+        expect_valid(dumbbell, "improvement with topology changes off");
+        EXPECT_EQ(triangle_components(dumbbell).count, 1);
+        EXPECT_EQ(euler_characteristic(dumbbell), 2);
+    }
+
+    SurfaceMesh torus = testing::make_test_torus();
+    improve.xi = 1.8 * testing::mean_edge_length(torus);  // coarsen hard: many collapses
+    for (int step = 0; step < 3; ++step) {
+        improve_mesh(torus, remesh, improve);
+        expect_valid(torus, "coarsening a torus with topology changes off");
+    }
+    EXPECT_EQ(euler_characteristic(torus), 0);
+    EXPECT_EQ(triangle_components(torus).count, 1);
+
+    SurfaceMesh spheres = testing::make_two_spheres(0.2, 0.002, 0.05);
+    improve.xi = testing::mean_edge_length(spheres);
+    improve_mesh(spheres, remesh, improve);
+    EXPECT_EQ(triangle_components(spheres).count, 2);
+    EXPECT_EQ(euler_characteristic(spheres), 4);
+}
+
+TEST(Separation, RemovesDegenerateTetrahedraAndSplitsSingularVertices) {
+    // Two tetrahedra sharing one vertex (a singular vertex), plus a duplicated pair of faces.
+    std::vector<Vec3> p = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 0, 1},
+                           {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
+    std::vector<Triangle> t = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3},
+                               {0, 4, 5}, {0, 6, 4}, {0, 5, 6}, {4, 6, 5}};
+    SurfaceMesh mesh(p, t);
+    ASSERT_TRUE(validate_mesh(mesh).empty());
+    const SeparationReport r = separate(mesh, SeparationOptions{}, true, 0.5);
+    EXPECT_EQ(r.singular_vertices_split, 1);
+    EXPECT_EQ(r.copies_created, 1);
+    EXPECT_EQ(vertex_fans(mesh, 0).size(), 1u);
+    EXPECT_TRUE(validate_mesh(mesh).empty());
+    EXPECT_TRUE(is_intersection_free(mesh));
+    EXPECT_EQ(triangle_components(mesh).count, 2);
+
+    // A degenerate tetrahedron: triangles (0,1,2) and (0,2,1) as a whole component.
+    SurfaceMesh flat({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 2, 1}});
+    const SeparationReport f = separate(flat, SeparationOptions{}, true, 0.5);
+    EXPECT_EQ(f.degenerate_tetrahedra_removed, 1);
+    EXPECT_EQ(f.orphan_vertices_removed, 3);
+    EXPECT_EQ(flat.count_live_triangles(), 0);
+}
+
+TEST(OpenSurfaces, BoundaryTakesPartInNoMerge) {
+    // An open cap next to a sphere: boundary edges never take part in merges.
+    SurfaceMesh cap = testing::make_test_open_cap();
+    TopologyOptions options;
+    TopologyContext context;
+    context.xi = testing::mean_edge_length(cap);
+    const TopologyReport r = change_topology(cap, options, context);
+    EXPECT_EQ(r.merge.merges, 0);
+    ValidationOptions vo;
+    vo.allow_boundary = true;
+    EXPECT_TRUE(validate_mesh(cap, vo).empty());
+}
+
+}  // namespace
+}  // namespace meniscus::tracker

@@ -1,0 +1,338 @@
+#include "tracker/remesh/collapse.h"
+
+#include "tracker/quadric.h"
+#include "tracker/remesh/butterfly.h"
+#include "tracker/remesh/local_safety.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace meniscus::tracker {
+
+namespace {
+
+constexpr double PI = 3.14159265358979323846;
+/// A triangle whose doubled area is below this fraction of its longest edge squared counts as
+/// degenerate (validate_mesh's default tolerance).
+constexpr double DEGENERATE_AREA_FRACTION = 1e-12;
+
+double edge_length(const SurfaceMesh& mesh, int ei) {
+    const Edge& e = mesh.edge(ei);
+    return (mesh.position(e[0]) - mesh.position(e[1])).norm();
+}
+
+void sort_unique(std::vector<int>& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+std::vector<int> neighbours(const SurfaceMesh& mesh, int vi) {
+    std::vector<int> n;
+    for (int ei : mesh.vertex_edges(vi))
+        n.push_back(mesh.other_vertex(ei, vi));
+    sort_unique(n);
+    return n;
+}
+
+/// Triangles incident to either endpoint, each once.
+std::vector<int> star_triangles(const SurfaceMesh& mesh, const CollapsePlan& plan) {
+    std::vector<int> tris = mesh.vertex_triangles(plan.kept);
+    const auto& other = mesh.vertex_triangles(plan.removed);
+    tris.insert(tris.end(), other.begin(), other.end());
+    sort_unique(tris);
+    return tris;
+}
+
+bool contains(const Triangle& t, int vi) {
+    return t[0] == vi || t[1] == vi || t[2] == vi;
+}
+
+/// Position of vi after the collapse.
+const Vec3& moved(const SurfaceMesh& mesh, const CollapsePlan& plan, int vi) {
+    return vi == plan.kept || vi == plan.removed ? plan.position : mesh.position(vi);
+}
+
+/// Parameter of `position` along the edge from kept to removed, clamped to [0, 1].
+double edge_parameter(const SurfaceMesh& mesh, const CollapsePlan& plan) {
+    const Vec3 d = mesh.position(plan.removed) - mesh.position(plan.kept);
+    const double length2 = d.squaredNorm();
+    if (!(length2 > 0.0))
+        return 0.0;
+    return std::clamp((plan.position - mesh.position(plan.kept)).dot(d) / length2, 0.0, 1.0);
+}
+
+/// Trajectory end points to try, preferred first, then towards the midpoint.
+struct PlanCandidates {
+    std::vector<CollapsePlan> plans;
+    bool feature_kept = false;
+};
+
+PlanCandidates plan_collapse(const SurfaceMesh& mesh, int ei, const RemeshOptions& options) {
+    const Edge& e = mesh.edge(ei);
+    const FeatureThresholds thresholds{options.ridge_eigenvalue_ratio,
+                                       options.corner_eigenvalue_ratio};
+    PlanCandidates out;
+    CollapsePlan base;
+    base.ei = ei;
+    base.kept = e[0];
+    base.removed = e[1];
+    const bool boundary0 = mesh.is_boundary_vertex(e[0]);
+    const bool boundary1 = mesh.is_boundary_vertex(e[1]);
+    if (boundary0 || boundary1) {
+        // §4.4: the boundary stays where it is; the interior endpoint moves onto it.
+        base.kept = boundary0 ? e[0] : e[1];
+        base.removed = mesh.other_vertex(ei, base.kept);
+        base.position = mesh.position(base.kept);
+        out.plans.push_back(base);
+        return out;
+    }
+    const auto f0 = static_cast<int>(vertex_quadric(mesh, e[0], thresholds).feature);
+    const auto f1 = static_cast<int>(vertex_quadric(mesh, e[1], thresholds).feature);
+    Vec3 preferred;
+    if (f0 != f1) {
+        base.kept = f0 > f1 ? e[0] : e[1];
+        base.removed = mesh.other_vertex(ei, base.kept);
+        preferred = mesh.position(base.kept);
+        out.feature_kept = true;
+    } else {
+        preferred = butterfly_point(mesh, ei).value_or(edge_midpoint(mesh, ei));
+    }
+    const Vec3 midpoint = edge_midpoint(mesh, ei);
+    const int n = options.collapse_position_attempts;
+    for (int k = 0; k < n; ++k) {
+        const double w = n == 1 ? 0.0 : static_cast<double>(k) / (n - 1);
+        CollapsePlan plan = base;
+        plan.position = (1.0 - w) * preferred + w * midpoint;
+        out.plans.push_back(plan);
+    }
+    return out;
+}
+
+enum class Refusal { none, topology, normal, volume, long_edge, collision };
+
+}  // namespace
+
+bool collapse_touches_boundary(const SurfaceMesh& mesh, int ei) {
+    const Edge& e = mesh.edge(ei);
+    return mesh.is_boundary_edge(ei) ||
+           (mesh.is_boundary_vertex(e[0]) && mesh.is_boundary_vertex(e[1]));
+}
+
+bool collapse_changes_topology(const SurfaceMesh& mesh, int ei) {
+    const Edge& e = mesh.edge(ei);
+    std::vector<int> opposite;
+    for (int ti : mesh.edge_triangles(ei))
+        opposite.push_back(mesh.opposite_vertex(ti, ei));
+    sort_unique(opposite);
+    const std::vector<int> n0 = neighbours(mesh, e[0]);
+    const std::vector<int> n1 = neighbours(mesh, e[1]);
+    std::vector<int> common;
+    std::set_intersection(n0.begin(), n0.end(), n1.begin(), n1.end(), std::back_inserter(common));
+    if (common != opposite)
+        return true;
+    constexpr size_t TETRAHEDRON_VALENCE = 3;
+    for (int vi : opposite)
+        if (mesh.vertex_edges(vi).size() <= TETRAHEDRON_VALENCE)
+            return true;
+    return false;
+}
+
+bool collapse_duplicates_triangle(const SurfaceMesh& mesh, const CollapsePlan& plan) {
+    for (int ti : mesh.vertex_triangles(plan.removed)) {
+        Triangle t = mesh.triangle(ti);
+        if (contains(t, plan.kept))
+            continue;
+        for (int& vi : t)
+            if (vi == plan.removed)
+                vi = plan.kept;
+        const int existing = mesh.find_triangle(t[0], t[1], t[2]);
+        if (existing == INVALID_INDEX)
+            continue;
+        // Same orientation when `existing` is a cyclic rotation of t.
+        const Triangle& u = mesh.triangle(existing);
+        for (int k = 0; k < 3; ++k)
+            if (u[k] == t[0] && u[(k + 1) % 3] == t[1])
+                return true;
+    }
+    return false;
+}
+
+bool collapse_inverts_normal(const SurfaceMesh& mesh, const CollapsePlan& plan,
+                             double max_normal_change_degrees) {
+    const double min_cos = std::cos(max_normal_change_degrees * PI / 180.0);
+    for (int ti : star_triangles(mesh, plan)) {
+        const Triangle& t = mesh.triangle(ti);
+        if (contains(t, plan.kept) && contains(t, plan.removed))
+            continue;  // deleted by the collapse
+        const Vec3 &p0 = mesh.position(t[0]), &p1 = mesh.position(t[1]), &p2 = mesh.position(t[2]);
+        const Vec3 &q0 = moved(mesh, plan, t[0]), &q1 = moved(mesh, plan, t[1]),
+                   &q2 = moved(mesh, plan, t[2]);
+        const Vec3 n_before = (p1 - p0).cross(p2 - p0);
+        const Vec3 n_after = (q1 - q0).cross(q2 - q0);
+        const double longest =
+            std::max({(q1 - q0).squaredNorm(), (q2 - q1).squaredNorm(), (q0 - q2).squaredNorm()});
+        if (n_after.norm() <= DEGENERATE_AREA_FRACTION * longest)
+            return true;
+        if (!(n_before.normalized().dot(n_after.normalized()) >= min_cos))
+            return true;
+    }
+    return false;
+}
+
+double collapse_volume_change(const SurfaceMesh& mesh, const CollapsePlan& plan) {
+    // Σ over the star of (after − before) signed tetrahedra against a local origin; triangles on
+    // the edge vanish (their "after" is flat). Both endpoints move, so both stars count.
+    const Vec3 origin = mesh.position(plan.kept);
+    double six_change = 0.0;
+    for (int ti : star_triangles(mesh, plan)) {
+        const Triangle& t = mesh.triangle(ti);
+        const Vec3 p0 = mesh.position(t[0]) - origin, p1 = mesh.position(t[1]) - origin,
+                   p2 = mesh.position(t[2]) - origin;
+        six_change -= p0.dot(p1.cross(p2));
+        if (contains(t, plan.kept) && contains(t, plan.removed))
+            continue;
+        const Vec3 q0 = moved(mesh, plan, t[0]) - origin, q1 = moved(mesh, plan, t[1]) - origin,
+                   q2 = moved(mesh, plan, t[2]) - origin;
+        six_change += q0.dot(q1.cross(q2));
+    }
+    return six_change / 6.0;
+}
+
+bool collapse_changes_volume_too_much(const SurfaceMesh& mesh, const CollapsePlan& plan,
+                                      double gamma) {
+    return std::abs(collapse_volume_change(mesh, plan)) > gamma;
+}
+
+bool collapse_creates_long_edge(const SurfaceMesh& mesh, const CollapsePlan& plan, double alpha) {
+    for (int vi : {plan.kept, plan.removed}) {
+        for (int ei : mesh.vertex_edges(vi)) {
+            const int n = mesh.other_vertex(ei, vi);
+            if (n == plan.kept || n == plan.removed)
+                continue;
+            const double after = (plan.position - mesh.position(n)).norm();
+            if (after > alpha && after > edge_length(mesh, ei))
+                return true;
+        }
+    }
+    return false;
+}
+
+bool collapse_collides(const SurfaceMesh& mesh, const ElementHash& hash, const CollapsePlan& plan) {
+    PseudoMotion motion;
+    motion.vertices = {plan.kept, plan.removed};
+    motion.x_t1 = {plan.position, plan.position};
+    motion.identified = {plan.kept, plan.removed};
+    return pseudo_motion_collides(mesh, hash, motion);
+}
+
+CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& options,
+                                    const ImproveContext& context) {
+    const auto start = std::chrono::steady_clock::now();
+    CollapseReport report;
+    const RemeshLimits limits = remesh_limits(options, context.xi);
+    std::unique_ptr<ElementHash> hash;
+    if (context.collision_safety)
+        hash = std::make_unique<ElementHash>(mesh, context.xi);
+
+    for (int pass = 0; pass < options.max_collapse_passes; ++pass) {
+        std::vector<std::pair<double, Edge>> short_edges;
+        for (int ei = 0; ei < mesh.num_edges(); ++ei) {
+            if (!mesh.edge_alive(ei))
+                continue;
+            const double length = edge_length(mesh, ei);
+            if (length < limits.min_edge_length)
+                short_edges.push_back({length, mesh.edge(ei)});
+        }
+        if (short_edges.empty())
+            break;
+        ++report.passes;
+        std::sort(short_edges.begin(), short_edges.end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
+        int collapses_this_pass = 0;
+        for (const auto& [length, e] : short_edges) {
+            const int ei = mesh.find_edge(e[0], e[1]);
+            if (ei == INVALID_INDEX || edge_length(mesh, ei) >= limits.min_edge_length)
+                continue;
+            if (collapse_touches_boundary(mesh, ei)) {
+                ++report.skipped_boundary;
+                continue;
+            }
+            if (mesh.edge_triangles(ei).size() != 2) {
+                ++report.skipped_nonmanifold;
+                continue;
+            }
+            if (!context.allow_topology_changes && collapse_changes_topology(mesh, ei)) {
+                ++report.refused_topology;
+                continue;
+            }
+            const PlanCandidates candidates = plan_collapse(mesh, ei, options);
+            Refusal refusal = Refusal::none;
+            int chosen = -1;
+            for (size_t k = 0; k < candidates.plans.size(); ++k) {
+                const CollapsePlan& plan = candidates.plans[k];
+                if (collapse_duplicates_triangle(mesh, plan))
+                    refusal = Refusal::topology;
+                else if (collapse_inverts_normal(mesh, plan, options.max_normal_change_degrees))
+                    refusal = Refusal::normal;
+                else if (collapse_changes_volume_too_much(mesh, plan, limits.max_volume_change))
+                    refusal = Refusal::volume;
+                else if (collapse_creates_long_edge(mesh, plan, limits.max_edge_length))
+                    refusal = Refusal::long_edge;
+                else if (hash && collapse_collides(mesh, *hash, plan))
+                    refusal = Refusal::collision;
+                else {
+                    chosen = static_cast<int>(k);
+                    break;
+                }
+            }
+            if (chosen < 0) {
+                switch (refusal) {
+                    case Refusal::topology:
+                        ++report.refused_topology;
+                        break;
+                    case Refusal::normal:
+                        ++report.refused_normal;
+                        break;
+                    case Refusal::volume:
+                        ++report.refused_volume;
+                        break;
+                    case Refusal::long_edge:
+                        ++report.refused_long_edge;
+                        break;
+                    case Refusal::collision:
+                        ++report.refused_collision;
+                        break;
+                    case Refusal::none:
+                        break;
+                }
+                continue;
+            }
+            const CollapsePlan& plan = candidates.plans[static_cast<size_t>(chosen)];
+            std::vector<int> touched;
+            for (int ti : star_triangles(mesh, plan))
+                for (int vi : mesh.triangle(ti))
+                    touched.push_back(vi);
+            sort_unique(touched);
+            if (hash)
+                hash->begin_update(mesh, touched);
+            mesh.collapse_edge(ei, plan.kept, plan.position, edge_parameter(mesh, plan));
+            if (hash)
+                hash->refresh(mesh, touched);
+            ++report.collapses;
+            ++collapses_this_pass;
+            report.retries_towards_midpoint += chosen > 0 ? 1 : 0;
+            report.feature_vertex_kept += candidates.feature_kept && chosen == 0 ? 1 : 0;
+        }
+        if (collapses_this_pass == 0)
+            break;
+    }
+    report.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+}
+
+}  // namespace meniscus::tracker

@@ -1,0 +1,87 @@
+#include "tracker/remesh/smooth.h"
+
+#include "tracker/quadric.h"
+
+#include <chrono>
+
+namespace meniscus::tracker {
+
+namespace {
+
+/// The smoothing pseudo-trajectory lasts one unit of pseudo-time (only displacements matter).
+constexpr double PSEUDO_STEP_DURATION = 1.0;
+
+}  // namespace
+
+std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const RemeshOptions& options,
+                                           SmoothReport* counts) {
+    const FeatureThresholds thresholds{options.ridge_eigenvalue_ratio,
+                                       options.corner_eigenvalue_ratio};
+    std::vector<Vec3> displacement(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty())
+            continue;
+        if (mesh.is_boundary_vertex(vi)) {
+            if (counts)
+                ++counts->boundary_vertices;
+            continue;
+        }
+        const VertexQuadric q = vertex_quadric(mesh, vi, thresholds);
+        if (q.feature == VertexFeature::corner) {
+            if (counts)
+                ++counts->corner_vertices;
+            continue;
+        }
+        if (q.feature == VertexFeature::ridge && counts)
+            ++counts->ridge_vertices;
+        Vec3 weighted_centroid = Vec3::Zero();
+        double total_area = 0.0;
+        for (int ti : mesh.vertex_triangles(vi)) {
+            const Triangle& t = mesh.triangle(ti);
+            const Vec3 &a = mesh.position(t[0]), &b = mesh.position(t[1]), &c = mesh.position(t[2]);
+            const double area = 0.5 * (b - a).cross(c - a).norm();
+            weighted_centroid += area * (a + b + c) / 3.0;
+            total_area += area;
+        }
+        if (!(total_area > 0.0))
+            continue;
+        const Vec3 towards = weighted_centroid / total_area - mesh.position(vi);
+        displacement[static_cast<size_t>(vi)] =
+            options.smoothing_step_fraction * (q.null_space_projector() * towards);
+    }
+    return displacement;
+}
+
+SmoothReport smooth_null_space(SurfaceMesh& mesh, const RemeshOptions& options,
+                               const ImproveContext& context) {
+    const auto start = std::chrono::steady_clock::now();
+    SmoothReport report;
+    for (int it = 0; it < options.smoothing_iterations; ++it) {
+        SmoothReport counts;
+        const std::vector<Vec3> displacement = null_space_displacements(mesh, options, &counts);
+        report.ridge_vertices = counts.ridge_vertices;
+        report.corner_vertices = counts.corner_vertices;
+        report.boundary_vertices = counts.boundary_vertices;
+        const std::vector<Vec3> x_t0 = mesh.positions();
+        std::vector<Vec3> x_t1 = x_t0;
+        for (size_t vi = 0; vi < x_t1.size(); ++vi) {
+            x_t1[vi] += displacement[vi];
+            report.vertices_moved += displacement[vi].squaredNorm() > 0.0 ? 1 : 0;
+        }
+        ++report.iterations;
+        if (context.collision_safety) {
+            report.collisions =
+                resolve_collisions(mesh, x_t0, x_t1, PSEUDO_STEP_DURATION, context.collision);
+            if (!report.collisions.collision_free) {
+                ++report.refused_collision;
+                continue;
+            }
+        }
+        mesh.set_positions(x_t1);
+    }
+    report.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+}
+
+}  // namespace meniscus::tracker

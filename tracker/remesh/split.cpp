@@ -1,0 +1,107 @@
+#include "tracker/remesh/split.h"
+
+#include "tracker/remesh/butterfly.h"
+#include "tracker/remesh/element_hash.h"
+#include "tracker/remesh/local_safety.h"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace meniscus::tracker {
+
+namespace {
+
+double edge_length(const SurfaceMesh& mesh, int ei) {
+    const Edge& e = mesh.edge(ei);
+    return (mesh.position(e[0]) - mesh.position(e[1])).norm();
+}
+
+}  // namespace
+
+bool split_allowed(const SurfaceMesh& mesh, int ei) {
+    return mesh.edge_triangles(ei).size() == 2;
+}
+
+bool split_butterfly_collides(const SurfaceMesh& mesh, const ElementHash& hash, int vi,
+                              const Vec3& target) {
+    PseudoMotion motion;
+    motion.vertices = {vi};
+    motion.x_t1 = {target};
+    return pseudo_motion_collides(mesh, hash, motion);
+}
+
+SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
+                             const ImproveContext& context) {
+    const auto start = std::chrono::steady_clock::now();
+    SplitReport report;
+    const double alpha = remesh_limits(options, context.xi).max_edge_length;
+    std::unique_ptr<ElementHash> hash;
+    if (context.collision_safety)
+        hash = std::make_unique<ElementHash>(mesh, context.xi);
+
+    for (int pass = 0; pass < options.max_split_passes; ++pass) {
+        std::vector<std::pair<double, Edge>> long_edges;
+        for (int ei = 0; ei < mesh.num_edges(); ++ei) {
+            if (!mesh.edge_alive(ei))
+                continue;
+            const double length = edge_length(mesh, ei);
+            if (length > alpha)
+                long_edges.push_back({length, mesh.edge(ei)});
+        }
+        if (long_edges.empty())
+            break;
+        ++report.passes;
+        std::sort(long_edges.begin(), long_edges.end(),
+                  [](const auto& a, const auto& b) { return a.first > b.first; });
+        int splits_this_pass = 0;
+        for (const auto& [length, e] : long_edges) {
+            const int ei = mesh.find_edge(e[0], e[1]);
+            if (ei == INVALID_INDEX || edge_length(mesh, ei) <= alpha)
+                continue;
+            if (mesh.is_boundary_edge(ei)) {
+                ++report.skipped_boundary;
+                continue;
+            }
+            if (!split_allowed(mesh, ei)) {
+                ++report.skipped_nonmanifold;
+                continue;
+            }
+            const std::optional<Vec3> butterfly = butterfly_point(mesh, ei);
+            const Vec3 midpoint = edge_midpoint(mesh, ei);
+            std::vector<int> touched = {e[0], e[1]};
+            for (int ti : mesh.edge_triangles(ei))
+                touched.push_back(mesh.opposite_vertex(ti, ei));
+            if (hash)
+                hash->begin_update(mesh, touched);
+            const int vi = mesh.split_edge(ei, midpoint, 0.5);
+            touched.push_back(vi);
+            if (hash)
+                hash->refresh(mesh, touched);
+            ++report.splits;
+            ++splits_this_pass;
+            if (!butterfly) {
+                ++report.butterfly_unavailable;
+                continue;
+            }
+            if (hash && split_butterfly_collides(mesh, *hash, vi, *butterfly)) {
+                ++report.butterfly_collides;
+                continue;
+            }
+            mesh.set_position(vi, *butterfly);
+            if (hash) {
+                hash->begin_update(mesh, {vi});
+                hash->refresh(mesh, {vi});
+            }
+        }
+        if (splits_this_pass == 0)
+            break;
+    }
+    report.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+}
+
+}  // namespace meniscus::tracker

@@ -1,0 +1,38 @@
+#pragma once
+/// \file Edge split (paper §3.5.1): edges longer than α get a new vertex, first at the midpoint
+/// (which cannot create an intersection), then moved to the butterfly point as a pseudo-motion
+/// checked by CCD; if that motion may collide the vertex stays at the midpoint. Boundary and
+/// non-manifold edges are never split (§3.5.1, §4.4).
+
+#include "tracker/mesh.h"
+#include "tracker/remesh/element_hash.h"
+#include "tracker/remesh_options.h"
+
+namespace meniscus::tracker {
+
+/// What a split pass did.
+struct SplitReport {
+    int splits = 0;                 ///< edges split
+    int butterfly_collides = 0;     ///< of those, kept at the midpoint: butterfly motion collided
+    int butterfly_unavailable = 0;  ///< of those, at the midpoint: no butterfly stencil
+    int skipped_boundary = 0;       ///< long boundary edges left alone (§4.4)
+    int skipped_nonmanifold = 0;    ///< long non-manifold edges left alone
+    int passes = 0;                 ///< sweeps over the long edges
+    double seconds = 0.0;
+};
+
+/// True when the edge may be split at all (exactly two triangles: not boundary, not
+/// non-manifold).
+bool split_allowed(const SurfaceMesh& mesh, int ei);
+
+/// True when moving new vertex `vi` (just created at a midpoint) to `target` may collide.
+bool split_butterfly_collides(const SurfaceMesh& mesh, const ElementHash& hash, int vi,
+                              const Vec3& target);
+
+/// Splits every edge longer than α, longest first, sweeping until none is left or
+/// `options.max_split_passes` sweeps ran. With `context.collision_safety` off the butterfly
+/// point is used without a check.
+SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
+                             const ImproveContext& context);
+
+}  // namespace meniscus::tracker

@@ -1,0 +1,102 @@
+#pragma once
+/// \file Options of collision-safe mesh improvement (paper §3.5–3.6) and topology changes
+/// (§3.6–3.7), and the per-step context the SurfaceTracker hands to `improve_mesh()` and
+/// `change_topology()`.
+///
+/// Lengths are fractions of ξ, the mean edge length of the initial mesh, and volumes fractions
+/// of ξ³, so a scene scales without retuning (paper §4: α = 1.5ξ, β = 0.5ξ, γ = 0.1ξ³).
+
+#include "tracker/collision_resolution.h"
+
+namespace meniscus::tracker {
+
+/// Mesh improvement: split, flip, collapse and null-space smoothing (§3.5, §3.6.1).
+struct RemeshOptions {
+    bool split = true;     ///< split edges longer than α (§3.5.1)
+    bool flip = true;      ///< flip non-Delaunay edges (§3.5.2)
+    bool collapse = true;  ///< collapse edges shorter than β (§3.5.3)
+    bool smooth = true;    ///< null-space smoothing (§3.6.1)
+
+    double max_edge_fraction = 1.5;           ///< α / ξ: edges longer than α are split, > min
+    double min_edge_fraction = 0.5;           ///< β / ξ: edges shorter than β collapse, > 0
+    double max_volume_change_fraction = 0.1;  ///< γ / ξ³ per flip or collapse, > 0
+
+    int max_split_passes = 4;     ///< sweeps over long edges per improvement, ≥ 1
+    int max_collapse_passes = 4;  ///< sweeps over short edges per improvement, ≥ 1
+    int max_flip_sweeps = 5;      ///< flip sweeps per improvement (paper: 5), ≥ 1
+    /// A flip must shorten the edge by at least this fraction of its length (stops flip-flops);
+    /// in [0, 1).
+    double min_flip_length_decrease_fraction = 1e-3;
+    /// Collapse trajectories tried, from the butterfly (or feature) position to the edge midpoint
+    /// in equal steps (§3.5.3 "retried towards the midpoint"), ≥ 1.
+    int collapse_position_attempts = 3;
+    /// Largest angle (degrees) between a triangle's normal before and after a collapse or flip,
+    /// in (0, 180]; 90 refuses only inversions. Face offsetting wants smaller values.
+    double max_normal_change_degrees = 60.0;
+
+    /// Quadric metric tensor A = Σ wᵢ nᵢ nᵢᵀ / Σ wᵢ (eigenvalues λ₁ ≥ λ₂ ≥ λ₃, summing to 1):
+    /// a vertex is on a ridge when λ₂ ≥ ridge_eigenvalue_ratio · λ₁, in (0, 1).
+    double ridge_eigenvalue_ratio = 0.1;
+    /// ... and at a corner when λ₃ ≥ corner_eigenvalue_ratio · λ₁, in (0, 1).
+    double corner_eigenvalue_ratio = 0.1;
+
+    int smoothing_iterations = 1;  ///< null-space smoothing steps per improvement, ≥ 0
+    /// Fraction of the null-space projected displacement to the area-weighted centroid of the
+    /// incident triangles applied per step, in (0, 1].
+    double smoothing_step_fraction = 0.5;
+
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// Separation of pinched surfaces (§3.6): removal of degenerate tetrahedra and duplication of
+/// singular vertices.
+struct SeparationOptions {
+    /// Each copy of a singular vertex moves towards the centroid of its triangle fan by this
+    /// fraction of the distance (so no two vertices share a point), in (0, 0.5).
+    double nudge_fraction = 0.01;
+    /// Halvings of the nudge tried when the nudged fans would intersect something, ≥ 0.
+    int max_nudge_halvings = 4;
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// Topology changes: merging (§3.7) and separation (§3.6).
+struct TopologyOptions {
+    bool allow_merging = true;     ///< zipper proximal edge pairs (§3.7)
+    bool allow_separation = true;  ///< remove degenerate tetrahedra, split singular vertices
+    /// Edge pairs closer than this fraction of ξ are merged, > 0. Must exceed the collision
+    /// proximity ε_p / ξ for approaching surfaces ever to merge.
+    double merge_distance_fraction = 0.1;
+    /// Closed-form zipper alignments tried per pair (cheapest first), in [1, 4].
+    int max_zipper_alignments = 4;
+    SeparationOptions separation;
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// Per-step facts `improve_mesh()` needs besides its options.
+struct ImproveContext {
+    double xi = 0.0;                     ///< ξ: initial mean edge length (metres, > 0)
+    bool collision_safety = true;        ///< §3.3 switch: check every operation for collisions
+    bool allow_topology_changes = true;  ///< §3.3 switch: false refuses pinching operations
+    /// Collision resolution for the smoothing pseudo-trajectory (absolute ε_p).
+    CollisionOptions collision;
+    /// Used to clean up after collapses and flips when topology changes are allowed.
+    SeparationOptions separation;
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// Per-step facts `change_topology()` needs besides its options.
+struct TopologyContext {
+    double xi = 0.0;               ///< ξ: initial mean edge length (metres, > 0)
+    bool collision_safety = true;  ///< §3.3 switch: refuse merges whose triangles intersect
+    void validate() const;         ///< throws std::invalid_argument naming the field
+};
+
+/// Absolute thresholds derived from options and ξ.
+struct RemeshLimits {
+    double max_edge_length = 0.0;    ///< α (metres)
+    double min_edge_length = 0.0;    ///< β (metres)
+    double max_volume_change = 0.0;  ///< γ (metres³)
+};
+RemeshLimits remesh_limits(const RemeshOptions& options, double xi);
+
+}  // namespace meniscus::tracker
