@@ -1,6 +1,7 @@
 #include "tracker/flows/curl_noise.h"
 #include "tracker/flows/face_offsetting.h"
 #include "tracker/flows/flow_errors.h"
+#include "tracker/flows/flow_runner.h"
 #include "tracker/flows/mean_curvature.h"
 #include "tracker/flows/vertex_normal_motion.h"
 #include "tracker/implicit_mesher.h"
@@ -14,6 +15,7 @@
 #include <iostream>
 #include <map>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace meniscus::tracker {
@@ -139,6 +141,58 @@ SurfaceMesh icosphere(const Vec3& center, double radius, int levels) {
     }
     for (Vec3& x : p)
         x = center + radius * x;
+    return SurfaceMesh(p, tris);
+}
+
+/// Two overlapping balls of radius r around (∓a, 0, 0) (a < r) meshed as two latitude–longitude
+/// caps sharing the ring where the spheres meet: every vertex on the exact union's boundary, a
+/// concave crease exactly on the ring. Spacing ≈ ξ along latitude lines and at the equator.
+SurfaceMesh peanut_mesh(double a, double r, double xi) {
+    const double phi_max = std::acos(-a / r);
+    const int n_lat = std::max(2, static_cast<int>(std::lround(r * phi_max / xi)));
+    const int n_lon = std::max(6, static_cast<int>(std::lround(2.0 * M_PI * r / xi)));
+    std::vector<Vec3> p;
+    std::vector<Triangle> tris;
+    std::vector<int> shared_ring;
+    for (int j = 0; j < n_lon; ++j) {
+        const double psi = 2.0 * M_PI * j / n_lon;
+        p.push_back(r * std::sin(phi_max) * Vec3(0.0, std::cos(psi), std::sin(psi)));
+        shared_ring.push_back(static_cast<int>(p.size()) - 1);
+    }
+    for (double side : {-1.0, 1.0}) {
+        const Vec3 c(side * a, 0.0, 0.0), e(side, 0.0, 0.0);
+        p.push_back(c + r * e);
+        const int pole = static_cast<int>(p.size()) - 1;
+        std::vector<std::vector<int>> rings;
+        for (int k = 1; k < n_lat; ++k) {
+            const double phi = phi_max * k / n_lat;
+            std::vector<int> ring;
+            for (int j = 0; j < n_lon; ++j) {
+                const double psi = 2.0 * M_PI * j / n_lon;
+                p.push_back(c + r * (std::cos(phi) * e +
+                                     std::sin(phi) * Vec3(0.0, std::cos(psi), std::sin(psi))));
+                ring.push_back(static_cast<int>(p.size()) - 1);
+            }
+            rings.push_back(ring);
+        }
+        rings.push_back(shared_ring);
+        auto add = [&](Triangle t) {
+            const Vec3& x0 = p[static_cast<size_t>(t[0])];
+            const Vec3 n =
+                (p[static_cast<size_t>(t[1])] - x0).cross(p[static_cast<size_t>(t[2])] - x0);
+            if (n.dot(x0 - c) < 0.0)
+                std::swap(t[1], t[2]);
+            tris.push_back(t);
+        };
+        for (int j = 0; j < n_lon; ++j) {
+            const size_t j0 = static_cast<size_t>(j), j1 = static_cast<size_t>((j + 1) % n_lon);
+            add({pole, rings[0][j0], rings[0][j1]});
+            for (size_t k = 0; k + 1 < rings.size(); ++k) {
+                add({rings[k][j0], rings[k + 1][j0], rings[k + 1][j1]});
+                add({rings[k][j0], rings[k + 1][j1], rings[k][j1]});
+            }
+        }
+    }
     return SurfaceMesh(p, tris);
 }
 
@@ -732,6 +786,128 @@ TEST(SurfaceErrorMeasure, L1IsTheAreaWeightedMeanDistance) {
     SurfaceErrorOptions bad;
     bad.triangle_subdivisions = 0;
     EXPECT_THROW(surface_error(square, plane, bad), std::invalid_argument);
+}
+
+// ---- flow runner -------------------------------------------------------------------------
+
+TEST(FlowRunner, FaceOffsettingSphereFollowsExactRadiusBothWays) {
+    const Vec3 center(0.25, 0.0, 0.0);
+    const double r0 = 0.2, speed = 0.2, t_end = 0.5;
+    for (double sign : {1.0, -1.0}) {
+        std::vector<double> errors, mean_edges;
+        for (double xi : {0.04, 0.02}) {
+            SurfaceMesh mesh = meshed_sphere(center, r0, xi);
+            project_to_sphere(mesh, center, r0);
+            mean_edges.push_back(edge_length_stats(mesh).mean);
+            const FaceOffsettingStepper stepper([&](double) { return sign * speed; });
+            const FlowRunReport report = run_flow(mesh, stepper, 0.0, t_end);
+            EXPECT_EQ(report.stop, FlowRunStop::reached_end);
+            EXPECT_EQ(report.t, t_end);
+            EXPECT_EQ(report.steps, 100);
+            EXPECT_EQ(report.shortened_steps, 0);
+            const SurfaceError e = sphere_error(mesh, center, r0 + sign * speed * t_end);
+            errors.push_back(e.vertex_linf);
+            std::cout << "[ measured ] face offsetting sphere 0.2 → " << r0 + sign * speed * t_end
+                      << ", ξ=" << mean_edges.back() << ", 100 steps: vertex L∞ " << e.vertex_linf
+                      << ", L∞ " << e.linf << ", L1 " << e.l1 << "\n";
+            EXPECT_LT(e.vertex_linf, 0.02 * speed * t_end);
+        }
+        EXPECT_GT(observed_order(errors[0], errors[1], mean_edges[0], mean_edges[1]), 1.5);
+    }
+}
+
+TEST(FlowRunner, NeckFaceOffsettingConvergesWhereVertexNormalsDoNot) {
+    // Two overlapping balls expanding: characteristics merge at the concave ring (a shock).
+    // Exact solution: the union of the two balls of radius r + s t (TwoSphereNormalFlow with
+    // centres ±a). Face offsetting tracks it; vertex normals lag at the ring by
+    // s t (1/cos θ − 1) whatever the resolution (paper Fig. 4.2).
+    TwoSphereNormalFlow flow;
+    const double a = 0.1;
+    flow.center0 = Vec3(-a, 0, 0);
+    flow.center1 = Vec3(a, 0, 0);
+    flow.initial_radius = 0.3;
+    flow.reversal_time = 1.0;
+    const double t_end = 0.1;  // s t = 0.02
+    std::vector<double> fo_errors, vn_errors, xis;
+    for (double xi : {0.04, 0.02, 0.01}) {
+        const SurfaceMesh initial = peanut_mesh(a, flow.initial_radius, xi);
+        ASSERT_LT(two_sphere_normal_flow_error(initial, flow, 0.0).vertex_linf, 1e-15);
+        SurfaceMesh fo = initial, vn = initial;
+        const NormalSpeed speed = [&flow](double t) { return flow.normal_speed(t); };
+        const FlowRunReport fo_report = run_flow(fo, FaceOffsettingStepper(speed), 0.0, t_end);
+        const FlowRunReport vn_report = run_flow(vn, VertexNormalStepper(speed), 0.0, t_end);
+        EXPECT_EQ(fo_report.stop, FlowRunStop::reached_end);
+        EXPECT_EQ(vn_report.stop, FlowRunStop::reached_end);
+        fo_errors.push_back(two_sphere_normal_flow_error(fo, flow, t_end).vertex_linf);
+        vn_errors.push_back(two_sphere_normal_flow_error(vn, flow, t_end).vertex_linf);
+        xis.push_back(edge_length_stats(initial).mean);
+        std::cout << "[ measured ] expanding neck ξ=" << xis.back()
+                  << ": vertex L∞ face offsetting " << fo_errors.back() << ", vertex normals "
+                  << vn_errors.back() << "\n";
+    }
+    const double fo_order = observed_order(fo_errors[0], fo_errors[2], xis[0], xis[2]);
+    const double vn_order = observed_order(vn_errors[0], vn_errors[2], xis[0], xis[2]);
+    std::cout << "[ measured ] observed order: face offsetting " << fo_order << ", vertex normals "
+              << vn_order << "\n";
+    EXPECT_GT(fo_order, 0.8);
+    EXPECT_LT(std::abs(vn_order), 0.2);
+    EXPECT_LT(fo_errors.back(), 0.2 * vn_errors.back());
+}
+
+TEST(FlowRunner, MeanCurvatureStepsAreCflLimited) {
+    SurfaceMesh mesh = meshed_sphere(Vec3::Zero(), 0.3, 0.04);
+    project_to_sphere(mesh, Vec3::Zero(), 0.3);
+    const double t_end = 0.005;
+    const FlowRunReport report = run_flow(mesh, MeanCurvatureStepper(), 0.0, t_end);
+    EXPECT_EQ(report.stop, FlowRunStop::reached_end);
+    EXPECT_GT(report.shortened_steps, 0);
+    EXPECT_LE(report.max_dt, MeanCurvatureFlowOptions{}.cfl_number * 0.04 * 0.04);
+    const SurfaceError e =
+        sphere_error(mesh, Vec3::Zero(), sphere_mean_curvature_radius(0.3, t_end));
+    EXPECT_LT(e.vertex_linf, 1e-3);
+}
+
+TEST(FlowRunner, IntegratorMayApplyPartOfTheMotion) {
+    /// Uniform translation along +x at 1 m/s.
+    class Uniform final : public VelocityField {
+    public:
+        Vec3 velocity(const Vec3&, double) const override { return Vec3::UnitX(); }
+    };
+    const Uniform field;
+    SurfaceMesh mesh = cube_mesh(0.1, 1);
+    const Vec3 start = mesh.position(0);
+    int hook_calls = 0;
+    FlowRunOptions options;
+    options.max_dt = 0.01;
+    // A cautious integrator: applies only half of the motion of full-length steps.
+    const FlowIntegrator half = [](SurfaceMesh& m, const std::vector<Vec3>& d, double dt) {
+        const double fraction = dt > 0.006 ? 0.5 : 1.0;
+        std::vector<Vec3> part = d;
+        for (Vec3& v : part)
+            v *= fraction;
+        move_vertices(m, part, dt);
+        return fraction * dt;
+    };
+    const FlowRunReport report =
+        run_flow(mesh, VelocityFieldStepper(field), 0.0, 0.1, options, half,
+                 [&hook_calls](SurfaceMesh&, double) { ++hook_calls; });
+    EXPECT_EQ(report.stop, FlowRunStop::reached_end);
+    EXPECT_EQ(report.t, 0.1);
+    EXPECT_EQ(report.steps, 20);  // twice as many as 0.1 / 0.01
+    EXPECT_EQ(report.partial_steps, 19);
+    EXPECT_EQ(hook_calls, report.steps);
+    EXPECT_NEAR((mesh.position(0) - start).x(), 0.1, 1e-12);
+
+    // An integrator that never moves anything stalls the run, which is reported.
+    const FlowIntegrator stuck = [](SurfaceMesh&, const std::vector<Vec3>&, double) { return 0.0; };
+    const FlowRunReport stalled =
+        run_flow(mesh, VelocityFieldStepper(field), 0.0, 0.1, options, stuck);
+    EXPECT_EQ(stalled.stop, FlowRunStop::step_stalled);
+    EXPECT_EQ(stalled.steps, 1);
+    options.max_steps = 3;
+    EXPECT_EQ(run_flow(mesh, VelocityFieldStepper(field), 0.0, 0.1, options).stop,
+              FlowRunStop::max_steps);
+    EXPECT_THROW(run_flow(mesh, VelocityFieldStepper(field), 0.1, 0.1), std::invalid_argument);
 }
 
 }  // namespace
