@@ -6,6 +6,7 @@
 #include "tracker/mesh_measures.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
 
@@ -51,13 +52,16 @@ void append_cube(std::vector<Vec3>& positions, std::vector<Triangle>& triangles,
     }
 }
 
-/// Welds vertices at identical positions.
+/// Welds vertices that coincide up to rounding (on a 1e-9 grid).
 SurfaceMesh weld(const std::vector<Vec3>& positions, const std::vector<Triangle>& triangles) {
-    std::map<std::array<double, 3>, int> index;
+    constexpr double WELD_GRID = 1e9;
+    std::map<std::array<long long, 3>, int> index;
     std::vector<int> remap(positions.size());
     std::vector<Vec3> welded;
     for (size_t i = 0; i < positions.size(); ++i) {
-        const std::array<double, 3> key{positions[i].x(), positions[i].y(), positions[i].z()};
+        const std::array<long long, 3> key{std::llround(positions[i].x() * WELD_GRID),
+                                           std::llround(positions[i].y() * WELD_GRID),
+                                           std::llround(positions[i].z() * WELD_GRID)};
         auto [it, inserted] = index.insert({key, static_cast<int>(welded.size())});
         if (inserted)
             welded.push_back(positions[i]);
@@ -90,6 +94,16 @@ SurfaceMesh make_test_edge_sharing_cubes() {
     constexpr int SUBDIVISIONS = 4;
     append_cube(positions, triangles, {0, 0, 0}, 0.4, SUBDIVISIONS);
     append_cube(positions, triangles, {0.4, 0.4, 0}, 0.4, SUBDIVISIONS);
+    return weld(positions, triangles);
+}
+
+SurfaceMesh make_two_cubes(double gap) {
+    std::vector<Vec3> positions;
+    std::vector<Triangle> triangles;
+    constexpr int SUBDIVISIONS = 3;
+    constexpr double SIDE = 0.4;
+    append_cube(positions, triangles, {0, 0, 0}, SIDE, SUBDIVISIONS);
+    append_cube(positions, triangles, {SIDE + gap, 0, 0}, SIDE, SUBDIVISIONS);
     return weld(positions, triangles);
 }
 

@@ -26,6 +26,8 @@ SurfaceMesh make_test_dumbbell();
 /// Two unit-ish subdivided cubes sharing one edge (non-manifold: 4 triangles on each piece of
 /// the shared edge, consistently oriented).
 SurfaceMesh make_test_edge_sharing_cubes();
+/// Two cubes of side 0.4 (each face a 3 × 3 grid) facing each other across `gap` along x.
+SurfaceMesh make_two_cubes(double gap);
 /// A sphere with a polar cap removed: an open surface with one boundary loop.
 SurfaceMesh make_test_open_cap();
 /// Two spheres of radius `radius` along x separated by `gap` (closest points 2·radius+gap
