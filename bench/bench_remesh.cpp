@@ -1,0 +1,161 @@
+// Time per step of collision-safe mesh improvement (improve_mesh: split, flip, collapse,
+// separation, flip, null-space smoothing) and of topology changes (change_topology: merge,
+// separation) at about 10k, 50k and 200k triangles (paper Table 4.4, "Improvement" and
+// "Topology" columns).
+//
+// Improvement: a sphere of radius 0.5 meshed at the edge length giving the requested triangle
+// count, then stretched by 1.5 along x and 1/√1.5 along y and z (as one step of a flow would),
+// so that edges leave [β, α] in both directions; each iteration improves a fresh copy. Topology:
+// two such spheres (half the triangles each) 0.02 ξ apart, so the merge pass finds proximal
+// edges and zips; each iteration works on a fresh copy. Counters are per iteration.
+
+#include "tracker/implicit_mesher.h"
+#include "tracker/implicit_shape.h"
+#include "tracker/mesh_measures.h"
+#include "tracker/remesh/improve.h"
+#include "tracker/topology/change_topology.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <map>
+#include <vector>
+
+namespace {
+
+using meniscus::tracker::SurfaceMesh;
+using meniscus::tracker::Triangle;
+using meniscus::tracker::Vec3;
+
+constexpr double RADIUS = 0.5;
+constexpr double STRETCH = 1.5;
+constexpr double MERGE_GAP_FRACTION = 0.02;  // of ξ, below the default merge distance 0.1 ξ
+
+/// Edge length giving about `triangles` triangles on a sphere of radius r (equilateral).
+double edge_length_for(int triangles, double r) {
+    const double area = 4.0 * M_PI * r * r;
+    return std::sqrt(area / (triangles * std::sqrt(3.0) / 4.0));
+}
+
+SurfaceMesh sphere_mesh(int triangles, double r, const Vec3& center) {
+    meniscus::tracker::ImplicitMeshOptions options;
+    options.edge_length = edge_length_for(triangles, r);
+    SurfaceMesh m =
+        meniscus::tracker::mesh_implicit_shape(*meniscus::tracker::make_sphere(center, r), options);
+    m.compact();
+    return m;
+}
+
+std::map<int, double>& unstretched_xi() {
+    static std::map<int, double> xi;
+    return xi;
+}
+
+double unstretched_mean_edge_length(int triangles) {
+    return unstretched_xi().at(triangles);
+}
+
+const SurfaceMesh& stretched_sphere(int triangles) {
+    static std::map<int, SurfaceMesh> cache;
+    auto it = cache.find(triangles);
+    if (it != cache.end())
+        return it->second;
+    SurfaceMesh m = sphere_mesh(triangles, RADIUS, Vec3::Zero());
+    unstretched_xi()[triangles] = meniscus::tracker::edge_length_stats(m).mean;
+    const double squeeze = 1.0 / std::sqrt(STRETCH);
+    for (int vi = 0; vi < m.num_vertices(); ++vi) {
+        const Vec3& p = m.position(vi);
+        m.set_position(vi, Vec3(STRETCH * p.x(), squeeze * p.y(), squeeze * p.z()));
+    }
+    return cache.emplace(triangles, std::move(m)).first->second;
+}
+
+/// Two mirror-image spheres (half the triangles each) whose closest vertices face each other
+/// across a gap of MERGE_GAP_FRACTION · ξ.
+const SurfaceMesh& touching_spheres(int triangles) {
+    static std::map<int, SurfaceMesh> cache;
+    auto it = cache.find(triangles);
+    if (it != cache.end())
+        return it->second;
+    const double r = RADIUS / std::sqrt(2.0);
+    const double xi = edge_length_for(triangles / 2, r);
+    const double offset = r + 0.5 * MERGE_GAP_FRACTION * xi;
+    SurfaceMesh a = sphere_mesh(triangles / 2, r, Vec3(-offset, 0, 0));
+    // Shift so the rightmost vertex sits exactly gap/2 left of the plane x = 0.
+    double max_x = -1e300;
+    for (int vi = 0; vi < a.num_vertices(); ++vi)
+        max_x = std::max(max_x, a.position(vi).x());
+    std::vector<Vec3> positions;
+    const double shift = -0.5 * MERGE_GAP_FRACTION * xi - max_x;
+    for (int vi = 0; vi < a.num_vertices(); ++vi)
+        positions.push_back(a.position(vi) + Vec3(shift, 0, 0));
+    const int n = a.num_vertices();
+    for (int vi = 0; vi < n; ++vi) {
+        Vec3 p = positions[static_cast<size_t>(vi)];
+        p.x() = -p.x();
+        positions.push_back(p);
+    }
+    std::vector<Triangle> tris;
+    for (int ti = 0; ti < a.num_triangles(); ++ti)
+        tris.push_back(a.triangle(ti));
+    for (int ti = 0; ti < a.num_triangles(); ++ti) {
+        const Triangle& t = a.triangle(ti);
+        tris.push_back({t[0] + n, t[2] + n, t[1] + n});
+    }
+    return cache.emplace(triangles, SurfaceMesh(positions, tris)).first->second;
+}
+
+void BM_ImproveMesh(benchmark::State& state) {
+    const int triangles = static_cast<int>(state.range(0));
+    const SurfaceMesh& base = stretched_sphere(triangles);
+    meniscus::tracker::RemeshOptions options;
+    meniscus::tracker::ImproveContext context;
+    context.xi = unstretched_mean_edge_length(triangles);
+    context.collision.proximity_epsilon = 1e-3 * context.xi;
+    meniscus::tracker::ImproveReport report;
+    for (auto _ : state) {
+        state.PauseTiming();
+        SurfaceMesh mesh = base;
+        state.ResumeTiming();
+        report = meniscus::tracker::improve_mesh(mesh, options, context);
+        benchmark::DoNotOptimize(mesh);
+    }
+    state.counters["triangles"] = base.count_live_triangles();
+    state.counters["splits"] = report.split.splits;
+    state.counters["flips"] = report.flip.flips;
+    state.counters["collapses"] = report.collapse.collapses;
+    state.counters["refused"] = report.flip.refused_total() + report.collapse.refused_total();
+    state.counters["split_s"] = report.split.seconds;
+    state.counters["flip_s"] = report.flip.seconds;
+    state.counters["collapse_s"] = report.collapse.seconds;
+    state.counters["separate_s"] = report.separation.seconds;
+    state.counters["smooth_s"] = report.smooth.seconds;
+}
+
+void BM_ChangeTopology(benchmark::State& state) {
+    const int triangles = static_cast<int>(state.range(0));
+    const SurfaceMesh& base = touching_spheres(triangles);
+    meniscus::tracker::TopologyOptions options;
+    meniscus::tracker::TopologyContext context;
+    context.xi = meniscus::tracker::edge_length_stats(base).mean;
+    meniscus::tracker::TopologyReport report;
+    for (auto _ : state) {
+        state.PauseTiming();
+        SurfaceMesh mesh = base;
+        state.ResumeTiming();
+        report = meniscus::tracker::change_topology(mesh, options, context);
+        benchmark::DoNotOptimize(mesh);
+    }
+    state.counters["triangles"] = base.count_live_triangles();
+    state.counters["candidates"] = report.merge.candidates;
+    state.counters["merges"] = report.merge.merges;
+    state.counters["merge_s"] = report.merge.seconds;
+    state.counters["separate_s"] = report.separation.seconds;
+}
+
+BENCHMARK(BM_ImproveMesh)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ChangeTopology)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
