@@ -438,20 +438,33 @@ TEST(FaceOffsetting, ShrinkingCubeStaysSharpWhereVertexNormalsRoundIt) {
     EXPECT_LT(fo_error, 1e-12);
     EXPECT_GT(vn_error, 0.2 * h);  // edges: (1 − 1/√2) h for symmetric fans
 
-    // Expanding: face offsetting keeps the vertices on the offset planes (a sharp box of
-    // half-width a + h); vertex normals cut the edges and corners.
+    // Expanding: the exact solution is the rounded dilation {dist(x, cube) = h}. The Huygens
+    // rule puts every vertex exactly on it (edge and corner vertices move by h inside their
+    // normal cones), as vertex normals also do here; the plane rule keeps a sharp box of
+    // half-width a + h instead.
+    const ShapePtr cube = make_box(Vec3::Constant(-a), Vec3::Constant(a));
     const ShapePtr sharp = make_box(Vec3::Constant(-(a + h)), Vec3::Constant(a + h));
     const FaceOffset grow = face_offset_displacements(mesh, 1.0, h);
+    FaceOffsettingOptions planes;
+    planes.expansion = ExpansionRule::planes;
+    const FaceOffset grow_sharp = face_offset_displacements(mesh, 1.0, h, planes);
     const std::vector<Vec3> vn_grow = vertex_normal_displacements(mesh, 1.0, h);
-    double fo_sharp = 0.0, vn_sharp = 0.0;
+    double fo_rounded = 0.0, vn_rounded = 0.0, planes_sharp = 0.0;
+    int expanding = 0;
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        const size_t i = static_cast<size_t>(vi);
         const Vec3& p = mesh.position(vi);
-        fo_sharp = std::max(
-            fo_sharp, std::abs(sharp->value(p + grow.displacements[static_cast<size_t>(vi)])));
-        vn_sharp = std::max(vn_sharp, std::abs(sharp->value(p + vn_grow[static_cast<size_t>(vi)])));
+        fo_rounded = std::max(fo_rounded, std::abs(cube->value(p + grow.displacements[i]) - h));
+        vn_rounded = std::max(vn_rounded, std::abs(cube->value(p + vn_grow[i]) - h));
+        planes_sharp =
+            std::max(planes_sharp, std::abs(sharp->value(p + grow_sharp.displacements[i])));
+        expanding += grow.expanding[i];
+        EXPECT_EQ(offset.expanding[i], 0);  // shrinking a convex body: shocks only
     }
-    EXPECT_LT(fo_sharp, 1e-12);
-    EXPECT_GT(vn_sharp, 0.2 * h);
+    EXPECT_LT(fo_rounded, 1e-12);
+    EXPECT_LT(vn_rounded, 1e-12);
+    EXPECT_LT(planes_sharp, 1e-12);
+    EXPECT_GT(expanding, 0);
 }
 
 TEST(FaceOffsetting, ConcaveCreaseRisesToThePlanesIntersection) {
@@ -475,6 +488,17 @@ TEST(FaceOffsetting, ConcaveCreaseRisesToThePlanesIntersection) {
               << "normal = " << gap / h << " h (exact h(1/cosθ − 1) = " << (1.0 / cos_theta - 1.0)
               << " h)\n";
     EXPECT_NEAR(gap, h * (1.0 / cos_theta - 1.0), 1e-14);
+    EXPECT_EQ(offset.expanding[static_cast<size_t>(crease)], 0);
+
+    // Moving down the valley opens an expansion fan: the exact crease point is h below
+    // (Huygens); the plane intersection would overshoot to h / cos θ.
+    const FaceOffset down = face_offset_displacements(mesh, -1.0, h);
+    EXPECT_EQ(down.expanding[static_cast<size_t>(crease)], 1);
+    EXPECT_LT((down.displacements[static_cast<size_t>(crease)] - Vec3(0, 0, -h)).norm(), 1e-14);
+    FaceOffsettingOptions planes;
+    planes.expansion = ExpansionRule::planes;
+    const FaceOffset down_sharp = face_offset_displacements(mesh, -1.0, h, planes);
+    EXPECT_LT((down_sharp.displacements[static_cast<size_t>(crease)] + expected).norm(), 1e-14);
 }
 
 TEST(FaceOffsetting, InversionLimitIsExactForOneTriangle) {
@@ -852,6 +876,45 @@ TEST(FlowRunner, NeckFaceOffsettingConvergesWhereVertexNormalsDoNot) {
     EXPECT_GT(fo_order, 0.8);
     EXPECT_LT(std::abs(vn_order), 0.2);
     EXPECT_LT(fo_errors.back(), 0.2 * vn_errors.back());
+}
+
+TEST(FlowRunner, ShrinkingNeckNeedsTheHuygensRuleToConverge) {
+    // Two overlapping balls moving inward: the concave ring opens an expansion fan; the exact
+    // solution is the erosion {dist(x, complement of U) > s t} with a rounded neck
+    // (TwoSphereNormalFlow with the reversal at t = 0). The plane-intersection rule keeps the
+    // crease sharp and overshoots by s t (1/cos θ − 1) at every resolution.
+    TwoSphereNormalFlow flow;
+    const double a = 0.1;
+    flow.center0 = Vec3(-a, 0, 0);
+    flow.center1 = Vec3(a, 0, 0);
+    flow.initial_radius = 0.3;
+    flow.reversal_time = 0.0;
+    const double t_end = 0.1;  // s t = 0.02
+    FaceOffsettingOptions planes;
+    planes.expansion = ExpansionRule::planes;
+    std::vector<double> huygens_errors, planes_errors, xis;
+    for (double xi : {0.04, 0.02, 0.01}) {
+        const SurfaceMesh initial = peanut_mesh(a, flow.initial_radius, xi);
+        SurfaceMesh huygens = initial, sharp = initial;
+        const NormalSpeed speed = [&flow](double t) { return flow.normal_speed(t); };
+        EXPECT_EQ(run_flow(huygens, FaceOffsettingStepper(speed), 0.0, t_end).stop,
+                  FlowRunStop::reached_end);
+        EXPECT_EQ(run_flow(sharp, FaceOffsettingStepper(speed, planes), 0.0, t_end).stop,
+                  FlowRunStop::reached_end);
+        huygens_errors.push_back(two_sphere_normal_flow_error(huygens, flow, t_end).vertex_linf);
+        planes_errors.push_back(two_sphere_normal_flow_error(sharp, flow, t_end).vertex_linf);
+        xis.push_back(edge_length_stats(initial).mean);
+        std::cout << "[ measured ] shrinking neck ξ=" << xis.back() << ": vertex L∞ Huygens rule "
+                  << huygens_errors.back() << ", plane rule " << planes_errors.back() << "\n";
+    }
+    const double huygens_order =
+        observed_order(huygens_errors[0], huygens_errors[2], xis[0], xis[2]);
+    const double planes_order = observed_order(planes_errors[0], planes_errors[2], xis[0], xis[2]);
+    std::cout << "[ measured ] observed order: Huygens rule " << huygens_order << ", plane rule "
+              << planes_order << "\n";
+    EXPECT_GT(huygens_order, 1.5);
+    EXPECT_LT(huygens_errors.back(), 0.02 * planes_errors.back());
+    EXPECT_GT(planes_errors.back(), 0.9 * planes_errors.front());  // no convergence
 }
 
 TEST(FlowRunner, MeanCurvatureStepsAreCflLimited) {

@@ -14,6 +14,9 @@ namespace {
 
 /// |(b − a) × (c − a)| below this times the squared longest edge counts as degenerate.
 constexpr double DEGENERATE_AREA_RATIO = 1e-14;
+/// |Σ wᵢ (cᵢ − x)·m| below this times Σ wᵢ |cᵢ − x| counts as flat (neither convex nor
+/// concave): the plane intersection is used.
+constexpr double FLAT_RATIO = 1e-9;
 /// Step reduction applied per retry in face_offset_step() when displacements are not linear in
 /// Δt (null-space smoothing on).
 constexpr double RETRY_REDUCTION = 0.5;
@@ -95,6 +98,11 @@ FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
     std::vector<Vec3> b_vector(nv, Vec3::Zero());
     std::vector<Vec3> centroid_sum(nv, Vec3::Zero());
     std::vector<double> area_sum(nv, 0.0);
+    std::vector<Vec3> normal_sum(nv, Vec3::Zero());  // Σ wᵢ nᵢ
+    std::vector<Vec3> spread_sum(nv, Vec3::Zero());  // Σ wᵢ (cᵢ − x)
+    std::vector<double> spread_norm(nv, 0.0);        // Σ wᵢ |cᵢ − x|
+    std::vector<double> offset_sum(nv, 0.0);         // Σ wᵢ hᵢ
+    std::vector<double> weight_sum(nv, 0.0);         // Σ wᵢ
 
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
         if (!mesh.triangle_alive(ti))
@@ -119,12 +127,18 @@ FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
             b_vector[vi] += w * offset * n;
             centroid_sum[vi] += area * centroid;
             area_sum[vi] += area;
+            normal_sum[vi] += w * n;
+            spread_sum[vi] += w * (centroid - p[k]);
+            spread_norm[vi] += w * (centroid - p[k]).norm();
+            offset_sum[vi] += w * offset;
+            weight_sum[vi] += w;
         }
     }
 
     FaceOffset result;
     result.displacements.assign(nv, Vec3::Zero());
     result.primary_rank.assign(nv, 0);
+    result.expanding.assign(nv, 0);
     for (size_t vi = 0; vi < nv; ++vi) {
         if (!mesh.vertex_alive(static_cast<int>(vi)) || area_sum[vi] <= 0.0)
             continue;
@@ -144,6 +158,17 @@ FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
                 ++rank;
             } else {
                 null_projector += ek * ek.transpose();
+            }
+        }
+        const double normal_length = normal_sum[vi].norm();
+        if (options.expansion == ExpansionRule::huygens && normal_length > 0.0) {
+            const Vec3 m = normal_sum[vi] / normal_length;
+            const double mean_offset = offset_sum[vi] / weight_sum[vi];
+            const double convexity = spread_sum[vi].dot(m);  // < 0: one-ring behind the plane
+            if (std::abs(convexity) > FLAT_RATIO * spread_norm[vi] &&
+                mean_offset * convexity < 0.0) {
+                d = mean_offset * m;
+                result.expanding[vi] = 1;
             }
         }
         if (options.null_space_smoothing > 0.0) {

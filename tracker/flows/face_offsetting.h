@@ -11,11 +11,20 @@
 /// the displacement there is Σ_primary (eₖ·b / λₖ) eₖ, i.e. the least-squares offset restricted
 /// to the directions the planes determine (1 on a smooth patch, 2 on a ridge, 3 at a corner).
 /// The null space (the other eₖ, tangential directions) gets an optional tangential smoothing
-/// move and otherwise no motion. Where offset planes converge (a shock: concave crease moving
-/// outward, convex crease moving inward) the vertex lands on the planes' intersection, which
-/// is the entropy solution that vertex-normal motion misses. At a crease that opens up (an
-/// expansion fan) the same rule keeps the crease sharp (its vertex on both offset planes); the
-/// exact solution is a rounded fan there, which mesh refinement must resolve.
+/// move and otherwise no motion.
+///
+/// Entropy condition. Where offset planes converge (a shock: concave crease moving outward,
+/// convex crease moving inward) the vertex lands on the planes' intersection: the entropy
+/// solution that vertex-normal motion misses. Where they diverge (an expansion fan: convex
+/// moving outward, concave moving inward) the planes' intersection would keep the crease sharp
+/// and overshoot the exact, rounded fan by h (1/cos θ − 1) per unit of travel, without
+/// converging under refinement. With `ExpansionRule::huygens` (default) such vertices instead
+/// move by the mean offset h̄ along the mean normal m = Σ wᵢ nᵢ / |Σ wᵢ nᵢ| (Huygens'
+/// principle: the exact fan point at distance h from the crease, for any m in the normal cone);
+/// remeshing then fills the widening fan. A vertex is expanding when h̄ · Σᵢ wᵢ (cᵢ − x)·m < 0,
+/// with cᵢ the incident triangles' centroids: the one-ring lies behind the tangent plane
+/// (convex) and the motion is outward, or in front (concave) and inward. On smooth patches both
+/// rules agree to O(h θ²).
 ///
 /// Weights wᵢ: triangle areas (default) or the triangle's interior angle at the vertex.
 ///
@@ -35,9 +44,16 @@ enum class OffsetWeighting {
     angle,  ///< interior angle of the triangle at the vertex (radians)
 };
 
+/// Treatment of vertices where the offset planes diverge (see the file comment).
+enum class ExpansionRule {
+    huygens,  ///< mean offset along the mean normal: the exact expansion-fan point
+    planes,   ///< least-squares plane intersection everywhere (sharp creases; Jiao's formula)
+};
+
 /// Options of face_offset_displacements().
 struct FaceOffsettingOptions {
     OffsetWeighting weighting = OffsetWeighting::area;
+    ExpansionRule expansion = ExpansionRule::huygens;
     /// Eigenvalues λₖ ≥ ratio·λ₁ of A form the primary space (Jiao's threshold ε); in (0, 1).
     double primary_eigenvalue_ratio = 0.003;
     /// Fraction in [0, 1] of the null-space projection of (area-weighted mean of the incident
@@ -55,6 +71,8 @@ struct FaceOffset {
     /// Per vertex slot: dimension of the primary space (1 smooth, 2 ridge, 3 corner; 0 for dead
     /// or isolated vertices).
     std::vector<int> primary_rank;
+    /// Per vertex slot: 1 if the vertex was treated as an expansion (Huygens rule), else 0.
+    std::vector<int> expanding;
 };
 
 /// Face-offsetting displacements over one step of length `dt` (s) with per-triangle normal
