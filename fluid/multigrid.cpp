@@ -209,6 +209,30 @@ void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::ve
     });
 }
 
+/// The first red half-sweep from x = 0: x = b / A_cc on red active cells, 0 elsewhere (same
+/// result as clearing x and calling smooth_colour(RED), in one pass without neighbour reads).
+void first_red_from_zero(const PoissonMatrix& a, const std::vector<double>& b,
+                         std::vector<double>& x) {
+    const int ni = a.ni(), nj = a.nj(), nk = a.nk();
+    const std::size_t sj = static_cast<std::size_t>(ni);
+    const std::size_t sk = static_cast<std::size_t>(ni) * nj;
+    const double* a_d = a.diag.data();
+    const double* bv = b.data();
+    double* xv = x.data();
+    tbb::parallel_for(tbb::blocked_range<int>(0, nk), [&](const tbb::blocked_range<int>& range) {
+        for (int k = range.begin(); k != range.end(); ++k) {
+            for (int j = 0; j < nj; ++j) {
+                const std::size_t row = sk * k + sj * j;
+                const int first_red = (j + k) % 2;
+                for (int i = 0; i < ni; ++i) {
+                    const std::size_t c = row + i;
+                    xv[c] = ((i % 2) == first_red && a_d[c] > 0.0) ? bv[c] / a_d[c] : 0.0;
+                }
+            }
+        }
+    });
+}
+
 /// coarse_b = Pᵀ fine_r on active coarse cells.
 void restrict_residual(const AxisTransfer* t, const PoissonMatrix& fine,
                        const std::vector<double>& fine_r, const PoissonMatrix& coarse,
@@ -318,8 +342,10 @@ MultigridPreconditioner::MultigridPreconditioner(const PoissonMatrix& matrix,
     }
     for (std::size_t l = 0; l < m_levels.size(); ++l) {
         const std::size_t n = level_matrix(l).size();
-        m_levels[l].x.assign(n, 0.0);
-        m_levels[l].b.assign(n, 0.0);
+        if (l > 0) {  // level 0 works on the caller's r and z
+            m_levels[l].x.assign(n, 0.0);
+            m_levels[l].b.assign(n, 0.0);
+        }
         m_levels[l].r.assign(n, 0.0);
     }
 }
@@ -328,40 +354,42 @@ const PoissonMatrix& MultigridPreconditioner::level_matrix(std::size_t level) co
     return level == 0 ? m_fine : m_levels[level].matrix;
 }
 
-void MultigridPreconditioner::cycle(std::size_t level) const {
+void MultigridPreconditioner::cycle(std::size_t level, const std::vector<double>& b,
+                                    std::vector<double>& x) const {
     const PoissonMatrix& a = level_matrix(level);
     const Level& data = m_levels[level];
-    std::fill(data.x.begin(), data.x.end(), 0.0);
     constexpr int RED = 0;
     constexpr int BLACK = 1;
+    // From x = 0 the first red half-sweep needs no neighbours; it also clears the black cells.
+    first_red_from_zero(a, b, x);
     if (level + 1 == m_levels.size()) {
         // Palindromic order R (B R)^n keeps the coarsest solve a symmetric operator.
-        smooth_colour(a, data.b, data.x, RED);
         for (int sweep = 0; sweep < m_options.coarsest_sweeps; ++sweep) {
-            smooth_colour(a, data.b, data.x, BLACK);
-            smooth_colour(a, data.b, data.x, RED);
+            smooth_colour(a, b, x, BLACK);
+            smooth_colour(a, b, x, RED);
         }
         return;
     }
-    for (int sweep = 0; sweep < m_options.smoothing_sweeps; ++sweep) {
-        smooth_colour(a, data.b, data.x, RED);
-        smooth_colour(a, data.b, data.x, BLACK);
+    smooth_colour(a, b, x, BLACK);
+    for (int sweep = 1; sweep < m_options.smoothing_sweeps; ++sweep) {
+        smooth_colour(a, b, x, RED);
+        smooth_colour(a, b, x, BLACK);
     }
-    a.residual(data.x, data.b, data.r);
+    a.residual(x, b, data.r);
     const PoissonMatrix& coarse = level_matrix(level + 1);
-    restrict_residual(data.transfer, a, data.r, coarse, m_levels[level + 1].b);
-    cycle(level + 1);
-    prolong_add(data.transfer, coarse, m_levels[level + 1].x, a, data.x);
+    const Level& next = m_levels[level + 1];
+    restrict_residual(data.transfer, a, data.r, coarse, next.b);
+    cycle(level + 1, next.b, next.x);
+    prolong_add(data.transfer, coarse, next.x, a, x);
     for (int sweep = 0; sweep < m_options.smoothing_sweeps; ++sweep) {
-        smooth_colour(a, data.b, data.x, BLACK);
-        smooth_colour(a, data.b, data.x, RED);
+        smooth_colour(a, b, x, BLACK);
+        smooth_colour(a, b, x, RED);
     }
 }
 
 void MultigridPreconditioner::apply(const std::vector<double>& r, std::vector<double>& z) const {
-    m_levels[0].b = r;
-    cycle(0);
-    z = m_levels[0].x;
+    z.resize(r.size());
+    cycle(0, r, z);
 }
 
 }  // namespace meniscus::fluid

@@ -53,13 +53,14 @@ public:
 private:
     struct Level {
         PoissonMatrix matrix;           ///< unused for level 0 (the caller's matrix)
-        mutable std::vector<double> x;  ///< correction on this level
-        mutable std::vector<double> b;  ///< right-hand side on this level
+        mutable std::vector<double> x;  ///< correction on this level (coarse levels only)
+        mutable std::vector<double> b;  ///< right-hand side on this level (coarse levels only)
         mutable std::vector<double> r;  ///< residual scratch
         AxisTransfer transfer[3];       ///< to the next coarser level
     };
     const PoissonMatrix& level_matrix(std::size_t level) const;
-    void cycle(std::size_t level) const;
+    /// One V-cycle from x = 0 on `level` for right-hand side b (x is overwritten).
+    void cycle(std::size_t level, const std::vector<double>& b, std::vector<double>& x) const;
 
     const PoissonMatrix& m_fine;
     MultigridOptions m_options;
