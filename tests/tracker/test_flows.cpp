@@ -782,6 +782,7 @@ TEST(SurfaceErrorMeasure, ExactSphereSampleHasZeroVertexError) {
     project_to_sphere(mesh, Vec3(0.1, 0.1, 0.1), radius);
     const SurfaceError e = sphere_error(mesh, Vec3(0.1, 0.1, 0.1), radius);
     EXPECT_LT(e.vertex_linf, 1e-15);
+    EXPECT_LT(e.vertex_l1, 1e-15);
     // Chords cut inside the sphere by at most ℓ²/(8R); L1 is a fraction of that.
     const double longest = edge_length_stats(mesh).max;
     EXPECT_GT(e.linf, 0.0);
@@ -805,6 +806,8 @@ TEST(SurfaceErrorMeasure, L1IsTheAreaWeightedMeanDistance) {
     e = surface_error(tilted, plane);
     EXPECT_NEAR(e.l1, 0.5, 1e-14);
     EXPECT_NEAR(e.linf, 1.0, 1e-15);
+    // Vertex L1: areas/3 per corner; triangle (0,1,2) has |φ| = 0, 1, 1 and (0,2,3) 0, 1, 0.
+    EXPECT_NEAR(e.vertex_l1, (0.5 / 3.0) * (0 + 1 + 1) + (0.5 / 3.0) * (0 + 1 + 0), 1e-15);
     EXPECT_NEAR(relative_volume_change(2.0, 2.1), 0.05, 1e-15);
     EXPECT_THROW(relative_volume_change(0.0, 1.0), std::invalid_argument);
     SurfaceErrorOptions bad;

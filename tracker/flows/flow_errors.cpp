@@ -7,6 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace meniscus::tracker {
 
@@ -21,18 +22,20 @@ SurfaceError surface_error(const SurfaceMesh& mesh,
                            const SurfaceErrorOptions& options) {
     options.validate();
     SurfaceError error;
+    std::vector<double> vertex_phi(static_cast<size_t>(mesh.num_vertices()), 0.0);
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
         if (!mesh.vertex_alive(vi))
             continue;
-        error.vertex_linf =
-            std::max(error.vertex_linf, std::abs(signed_distance(mesh.position(vi))));
+        const double phi = std::abs(signed_distance(mesh.position(vi)));
+        vertex_phi[static_cast<size_t>(vi)] = phi;
+        error.vertex_linf = std::max(error.vertex_linf, phi);
         ++error.samples;
     }
     error.linf = error.vertex_linf;
 
     const int m = options.triangle_subdivisions;
     const double inv_m = 1.0 / m;
-    double weighted_sum = 0.0;
+    double weighted_sum = 0.0, vertex_weighted_sum = 0.0;
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
         if (!mesh.triangle_alive(ti))
             continue;
@@ -62,8 +65,11 @@ SurfaceError surface_error(const SurfaceMesh& mesh,
             }
         weighted_sum += area * sum / (m * m);
         error.area += area;
+        for (int vi : t)
+            vertex_weighted_sum += area / 3.0 * vertex_phi[static_cast<size_t>(vi)];
     }
     error.l1 = error.area > 0.0 ? weighted_sum / error.area : 0.0;
+    error.vertex_l1 = error.area > 0.0 ? vertex_weighted_sum / error.area : 0.0;
     return error;
 }
 

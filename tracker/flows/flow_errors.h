@@ -10,8 +10,14 @@
 /// (§4.1, Table 4.1) does not define its norms; this is the standard surface-to-surface choice.
 /// Sample points: each triangle is cut into m² congruent sub-triangles (m =
 /// `triangle_subdivisions`); ∫_T |φ| is the midpoint rule over their centroids, and L∞ also
-/// takes the lattice points (corners of the sub-triangles). The vertex-only maximum is reported
-/// separately, since vertices sit on the surface while chords cut inside it by about ℓ²/(8R).
+/// takes the lattice points (corners of the sub-triangles). Vertex-only measures are reported
+/// separately, since vertices sit on the surface while chords cut inside it by about ℓ²/(8R):
+///
+///     vertex L∞ = max over live vertices of |φ(xᵥ)|,
+///     vertex L1 = Σᵥ Aᵥ |φ(xᵥ)| / Σᵥ Aᵥ,  Aᵥ = one third of the areas of v's live triangles.
+///
+/// The sampled measures include the polygonal mesh's own chord error (about ℓ²/(12R) on
+/// average for a sphere mesh with vertices on the sphere); the vertex measures do not.
 
 #include "tracker/mesh.h"
 
@@ -30,6 +36,7 @@ struct SurfaceError {
     double linf = 0.0;         ///< max |φ| over vertices and triangle samples
     double l1 = 0.0;           ///< area-weighted mean |φ|
     double vertex_linf = 0.0;  ///< max |φ| over live vertices only
+    double vertex_l1 = 0.0;    ///< mean |φ| over vertices weighted by barycentric vertex areas
     double area = 0.0;         ///< total live triangle area (m²)
     long samples = 0;          ///< number of φ evaluations
 };
