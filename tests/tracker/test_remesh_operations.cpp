@@ -4,6 +4,7 @@
 
 #include "remesh_test_meshes.h"
 
+#include "tracker/intersection.h"
 #include "tracker/mesh_intersections.h"
 #include "tracker/mesh_io.h"
 #include "tracker/mesh_measures.h"
@@ -70,6 +71,58 @@ public:
 private:
     const SurfaceMesh& m_mesh;
     double m_last;
+};
+
+/// Checks the mesh after every split and collapse: connectivity in full, intersections of
+/// every triangle the operation changed (the star of the new or kept vertex, and of the
+/// previous split's vertex, which its butterfly move displaced) against all triangles, exactly.
+/// An operation changes only those triangles, so with the full checks before and after the
+/// pass this equals a full exact check after every operation.
+class EveryOperationChecker : public MeshObserver {
+public:
+    EveryOperationChecker(const SurfaceMesh& mesh, bool open) : m_mesh(mesh), m_open(open) {}
+    void on_edge_split(int, int, int new_vi, double) override { check(new_vi); }
+    void on_edge_collapse(int kept_vi, int, double) override { check(kept_vi); }
+    int operations = 0, invalid = 0, intersecting = 0;
+
+private:
+    void check(int vi) {
+        ++operations;
+        ValidationOptions vo;
+        vo.allow_boundary = m_open;
+        invalid += validate_mesh(m_mesh, vo).empty() ? 0 : 1;
+        bool hit = star_intersects(vi);
+        if (m_previous != INVALID_INDEX && m_mesh.vertex_alive(m_previous))
+            hit = hit || star_intersects(m_previous);
+        intersecting += hit ? 1 : 0;
+        m_previous = vi;
+    }
+    std::array<Vec3, 3> corners(const Triangle& t) const {
+        return {m_mesh.position(t[0]), m_mesh.position(t[1]), m_mesh.position(t[2])};
+    }
+    Box3d box(const Triangle& t) const {
+        Box3d b(m_mesh.position(t[0]));
+        b.extend(m_mesh.position(t[1]));
+        b.extend(m_mesh.position(t[2]));
+        return b;
+    }
+    bool star_intersects(int vi) const {
+        for (int ti : m_mesh.vertex_triangles(vi)) {
+            const Triangle& t = m_mesh.triangle(ti);
+            const Box3d bt = box(t);
+            for (int tj = 0; tj < m_mesh.num_triangles(); ++tj) {
+                if (tj == ti || !m_mesh.triangle_alive(tj))
+                    continue;
+                const Triangle& u = m_mesh.triangle(tj);
+                if (bt.intersects(box(u)) && triangles_intersect(corners(t), t, corners(u), u))
+                    return true;
+            }
+        }
+        return false;
+    }
+    const SurfaceMesh& m_mesh;
+    bool m_open;
+    int m_previous = INVALID_INDEX;
 };
 
 class RemeshOnTestData : public ::testing::TestWithParam<std::string> {
@@ -141,6 +194,26 @@ TEST_P(RemeshOnTestData, EveryPassKeepsTheMeshValidAndIntersectionFree) {
     expect_admissible(m, "smoothing");
 
     EXPECT_EQ(boundary_signature(m.mesh), boundary) << m.name << ": the open boundary changed";
+}
+
+TEST_P(RemeshOnTestData, EverySingleSplitAndCollapseKeepsTheMeshValidAndIntersectionFree) {
+    NamedMesh m = load();
+    const double xi0 = testing::mean_edge_length(m.mesh);
+    RemeshOptions options;
+    ImproveContext context;
+    context.allow_topology_changes = false;
+    ASSERT_TRUE(is_intersection_free(m.mesh));
+    EveryOperationChecker checker(m.mesh, m.open);
+    m.mesh.add_observer(&checker);
+    context.xi = 0.6 * xi0;
+    split_long_edges(m.mesh, options, context);
+    context.xi = 1.5 * xi0;
+    collapse_short_edges(m.mesh, options, context);
+    m.mesh.remove_observer(&checker);
+    EXPECT_GT(checker.operations, 0) << m.name;
+    EXPECT_EQ(checker.invalid, 0) << m.name;
+    EXPECT_EQ(checker.intersecting, 0) << m.name;
+    expect_admissible(m, "the last operation");
 }
 
 TEST_P(RemeshOnTestData, ImprovementBringsEdgesIntoRangeExceptWhereRefused) {
@@ -298,8 +371,12 @@ TEST(RemeshCollisionSafety, NearlyTouchingCubesStayApartUnderRefinementAndCoarse
     context.xi = 0.5 * xi0;
     context.collision_safety = false;
     options.smooth = false;
+    EveryOperationChecker checker(unsafe, false);
+    unsafe.add_observer(&checker);
     improve_mesh(unsafe, options, context);
+    unsafe.remove_observer(&checker);
     EXPECT_FALSE(is_intersection_free(unsafe));
+    EXPECT_GT(checker.intersecting, 0) << "the per-operation check must see it too";
 }
 
 /// Regenerates tests/data/*.obj: run with --gtest_also_run_disabled_tests.

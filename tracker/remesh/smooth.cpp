@@ -3,6 +3,7 @@
 #include "tracker/quadric.h"
 
 #include <chrono>
+#include <cstdint>
 
 namespace meniscus::tracker {
 
@@ -70,8 +71,13 @@ SmoothReport smooth_null_space(SurfaceMesh& mesh, const RemeshOptions& options,
         }
         ++report.iterations;
         if (context.collision_safety) {
-            report.collisions =
-                resolve_collisions(mesh, x_t0, x_t1, PSEUDO_STEP_DURATION, context.collision);
+            // Collision response must not move the open boundary either (§4.4).
+            std::vector<std::uint8_t> pinned(x_t0.size(), 0);
+            for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+                pinned[static_cast<size_t>(vi)] =
+                    mesh.vertex_alive(vi) && mesh.is_boundary_vertex(vi) ? 1 : 0;
+            report.collisions = resolve_collisions(mesh, x_t0, x_t1, PSEUDO_STEP_DURATION,
+                                                   context.collision, nullptr, &pinned);
             if (!report.collisions.collision_free) {
                 ++report.refused_collision;
                 continue;

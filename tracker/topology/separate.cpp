@@ -14,6 +14,9 @@ namespace meniscus::tracker {
 
 namespace {
 
+/// Each retry halves the nudge.
+constexpr double NUDGE_REDUCTION = 0.5;
+
 int find_root(std::vector<int>& parent, int i) {
     while (parent[static_cast<size_t>(i)] != i) {
         parent[static_cast<size_t>(i)] =
@@ -150,7 +153,7 @@ SeparationReport separate(SurfaceMesh& mesh, const SeparationOptions& options,
                 accepted = true;
                 break;
             }
-            fraction *= 0.5;
+            fraction *= NUDGE_REDUCTION;
         }
         if (!accepted) {
             ++report.refused_intersection;
