@@ -1,7 +1,8 @@
 #pragma once
 /// \file Collision-safe mesh improvement (paper §3.3, §3.5, §3.6): one call per time step runs
-/// split → flip → collapse → (separation, when topology changes are allowed) → flip → null-space
-/// smoothing, each operation only if enabled in RemeshOptions.
+/// null-space smoothing → split → flip → collapse → (separation, when topology changes are
+/// allowed), each operation only if enabled in RemeshOptions. Smoothing comes first (the paper
+/// lists it last) so that the edge-length operations have the last word.
 
 #include "tracker/mesh.h"
 #include "tracker/remesh/collapse.h"
@@ -16,7 +17,7 @@ namespace meniscus::tracker {
 /// Everything improve_mesh() did, per operation, with refusals and their reasons.
 struct ImproveReport {
     SplitReport split;
-    FlipReport flip;  ///< both flip passes summed
+    FlipReport flip;
     CollapseReport collapse;
     /// Cleanup after collapses and flips (only with topology changes allowed).
     SeparationReport separation;
@@ -26,8 +27,10 @@ struct ImproveReport {
 
 /// Improves `mesh` in place. Precondition for the collision-safety guarantee: the mesh is
 /// intersection-free on entry; it then stays so after every operation (with
-/// context.collision_safety). Edges end in [β, α] except where an operation was skipped or
-/// refused (see the report). Dead elements are left for the caller to compact().
+/// context.collision_safety). On return every edge with two triangles is at most α long, and
+/// every such edge not touching the open boundary at least β, except where a collapse was
+/// refused (report.collapse) or the pass limits ran out; separation nudges may shift the edges at
+/// split singular vertices by a tiny fraction. Dead elements are left for the caller to compact().
 /// Throws std::invalid_argument (naming the field) when options or context are invalid.
 ImproveReport improve_mesh(SurfaceMesh& mesh, const RemeshOptions& options,
                            const ImproveContext& context);
