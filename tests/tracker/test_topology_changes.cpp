@@ -4,6 +4,7 @@
 
 #include "remesh_test_meshes.h"
 
+#include "tracker/collision_resolution.h"
 #include "tracker/mesh_intersections.h"
 #include "tracker/mesh_measures.h"
 #include "tracker/mesh_validate.h"
@@ -70,6 +71,41 @@ TEST(Merge, TwoTouchingSpheresBecomeOneSphere) {
     expect_valid(mesh, "improvement after merging");
     EXPECT_EQ(triangle_components(mesh).count, 1);
     EXPECT_EQ(euler_characteristic(mesh), 2);
+}
+
+TEST(Merge, SpheresPushedTogetherMergeWhileEveryStepStaysValidAndIntersectionFree) {
+    // A small time loop: both spheres are pushed towards each other every step (collision
+    // resolution stops them), then improved and merged. Pushing on after contact keeps creating
+    // new contacts around the neck, so several zips (handles) are expected; what must hold is
+    // admissibility and no intersection after every stage of every step.
+    constexpr double RADIUS = 0.2, GAP = 0.03, EDGE = 0.05, PUSH = 0.004;
+    SurfaceMesh mesh = testing::make_two_spheres(RADIUS, GAP, EDGE);
+    const double xi = testing::mean_edge_length(mesh);
+    RemeshOptions remesh;
+    ImproveContext improve;
+    improve.xi = xi;
+    improve.collision.proximity_epsilon = 1e-3 * xi;
+    TopologyOptions topology;
+    TopologyContext topo_context;
+    topo_context.xi = xi;
+    int merges = 0;
+    constexpr int STEPS = 12;
+    for (int step = 0; step < STEPS; ++step) {
+        const std::vector<Vec3> x_t0 = mesh.positions();
+        std::vector<Vec3> x_t1 = x_t0;
+        for (size_t vi = 0; vi < x_t1.size(); ++vi)
+            x_t1[vi].x() += x_t0[vi].x() < 0.0 ? PUSH : -PUSH;
+        resolve_collisions(mesh, x_t0, x_t1, 1.0, improve.collision);
+        mesh.set_positions(x_t1);
+        expect_valid(mesh, "the push");
+        improve_mesh(mesh, remesh, improve);
+        expect_valid(mesh, "improvement");
+        merges += change_topology(mesh, topology, topo_context).merge.merges;
+        expect_valid(mesh, "topology change");
+        mesh.compact();
+    }
+    EXPECT_GE(merges, 1);
+    EXPECT_EQ(triangle_components(mesh).count, 1);
 }
 
 TEST(Merge, FarApartSpheresDoNotMergeAndMergingOffDoesNothing) {
