@@ -234,9 +234,14 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
     const auto start = std::chrono::steady_clock::now();
     CollapseReport report;
     const RemeshLimits limits = remesh_limits(options, context.xi);
+    // Built on the first collision check (a pass with nothing to do never pays for it), then
+    // kept current through every mutation.
     std::unique_ptr<ElementHash> hash;
-    if (context.collision_safety)
-        hash = std::make_unique<ElementHash>(mesh, context.xi);
+    auto current_hash = [&]() -> const ElementHash& {
+        if (!hash)
+            hash = std::make_unique<ElementHash>(mesh, context.xi);
+        return *hash;
+    };
 
     for (int pass = 0; pass < options.max_collapse_passes; ++pass) {
         std::vector<std::pair<double, Edge>> short_edges;
@@ -282,7 +287,7 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
                     refusal = Refusal::volume;
                 else if (collapse_creates_long_edge(mesh, plan, limits.max_edge_length))
                     refusal = Refusal::long_edge;
-                else if (hash && collapse_collides(mesh, *hash, plan))
+                else if (context.collision_safety && collapse_collides(mesh, current_hash(), plan))
                     refusal = Refusal::collision;
                 else {
                     chosen = static_cast<int>(k);

@@ -139,9 +139,14 @@ FlipReport flip_edges(SurfaceMesh& mesh, const RemeshOptions& options,
     const auto start = std::chrono::steady_clock::now();
     FlipReport report;
     const double gamma = remesh_limits(options, context.xi).max_volume_change;
+    // Built on the first collision check (a pass with nothing to do never pays for it), then
+    // kept current through every mutation.
     std::unique_ptr<ElementHash> hash;
-    if (context.collision_safety)
-        hash = std::make_unique<ElementHash>(mesh, context.xi);
+    auto current_hash = [&]() -> const ElementHash& {
+        if (!hash)
+            hash = std::make_unique<ElementHash>(mesh, context.xi);
+        return *hash;
+    };
 
     for (int sweep = 0; sweep < options.max_flip_sweeps; ++sweep) {
         ++report.sweeps;
@@ -165,11 +170,11 @@ FlipReport flip_edges(SurfaceMesh& mesh, const RemeshOptions& options,
                 ++report.refused_normal;
                 continue;
             }
-            if (hash && flip_intersects(mesh, *hash, s)) {
+            if (context.collision_safety && flip_intersects(mesh, current_hash(), s)) {
                 ++report.refused_intersection;
                 continue;
             }
-            if (hash && flip_sweeps_vertex(mesh, *hash, s)) {
+            if (context.collision_safety && flip_sweeps_vertex(mesh, current_hash(), s)) {
                 ++report.refused_point_in_tetrahedron;
                 continue;
             }

@@ -38,9 +38,14 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
     const auto start = std::chrono::steady_clock::now();
     SplitReport report;
     const double alpha = remesh_limits(options, context.xi).max_edge_length;
+    // Built on the first collision check (a pass with nothing to do never pays for it), then
+    // kept current through every mutation.
     std::unique_ptr<ElementHash> hash;
-    if (context.collision_safety)
-        hash = std::make_unique<ElementHash>(mesh, context.xi);
+    auto current_hash = [&]() -> const ElementHash& {
+        if (!hash)
+            hash = std::make_unique<ElementHash>(mesh, context.xi);
+        return *hash;
+    };
 
     for (int pass = 0; pass < options.max_split_passes; ++pass) {
         std::vector<std::pair<double, Edge>> long_edges;
@@ -86,7 +91,8 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
                 ++report.butterfly_unavailable;
                 continue;
             }
-            if (hash && split_butterfly_collides(mesh, *hash, vi, *butterfly)) {
+            if (context.collision_safety &&
+                split_butterfly_collides(mesh, current_hash(), vi, *butterfly)) {
                 ++report.butterfly_collides;
                 continue;
             }
