@@ -360,6 +360,80 @@ TEST(Quadric, ClassifiesSmoothRidgeAndCorner) {
     EXPECT_GT(corner, 0);
 }
 
+TEST(NullSpaceSmoothing, KeepsFacesRidgesAndCornersOfCubes) {
+    // Face vertices slide in their face, ridge vertices along their ridge, corners stay: the
+    // shape (and so the volume) is unchanged while the vertices move.
+    SurfaceMesh cubes = testing::make_test_edge_sharing_cubes();
+    auto planes_of = [](const Vec3& p) {
+        int planes = 0;
+        for (int k = 0; k < 3; ++k)
+            for (double c : {0.0, 0.4, 0.8})
+                planes += std::abs(p[k] - c) < 1e-12 ? 1 : 0;
+        return planes;
+    };
+    std::vector<int> before;
+    for (int vi = 0; vi < cubes.num_vertices(); ++vi)
+        before.push_back(planes_of(cubes.position(vi)));
+    const double volume = enclosed_volume(cubes);
+    RemeshOptions options;
+    options.smoothing_iterations = 3;
+    ImproveContext context;
+    context.xi = testing::mean_edge_length(cubes);
+    const std::vector<Vec3> x_t0 = cubes.positions();
+    const SmoothReport r = smooth_null_space(cubes, options, context);
+    EXPECT_GT(r.vertices_moved, 0);
+    EXPECT_GT(r.ridge_vertices, 0);
+    EXPECT_GT(r.corner_vertices, 0);
+    int moved = 0;
+    for (int vi = 0; vi < cubes.num_vertices(); ++vi) {
+        EXPECT_GE(planes_of(cubes.position(vi)), before[static_cast<size_t>(vi)])
+            << "vertex " << vi << " left its face, ridge or corner";
+        moved += (cubes.position(vi) - x_t0[static_cast<size_t>(vi)]).norm() > 1e-9 ? 1 : 0;
+    }
+    EXPECT_GT(moved, 0);
+    EXPECT_NEAR(enclosed_volume(cubes), volume, 1e-12);
+    EXPECT_TRUE(validate_mesh(cubes).empty());
+    EXPECT_TRUE(is_intersection_free(cubes));
+}
+
+TEST(Flip, NonManifoldEdgeFlipsOnAConsistentlyOrientedPairOfOneBody) {
+    // Two flat triangular bipyramids sharing their long edge (0, 1): four triangles on it.
+    // Equator (0, 1, e), apexes c and d close to the edge's midpoint, so (0, 1) is far from
+    // Delaunay; the second body is the first mirrored in y.
+    std::vector<Vec3> p = {{-1, 0, 0}, {1, 0, 0}};
+    std::vector<Triangle> t;
+    for (const double side : {1.0, -1.0}) {
+        const int e = static_cast<int>(p.size());
+        p.push_back({0, side, 0});
+        p.push_back({0, 0.05 * side, 0.05});   // c
+        p.push_back({0, 0.05 * side, -0.05});  // d
+        const int c = e + 1, d = e + 2;
+        std::vector<Triangle> body = {{0, 1, c}, {1, e, c}, {e, 0, c},
+                                      {1, 0, d}, {e, 1, d}, {0, e, d}};
+        if (SurfaceMesh(p, body).num_triangles() > 0 && enclosed_volume(SurfaceMesh(p, body)) < 0)
+            for (Triangle& tri : body)
+                std::swap(tri[1], tri[2]);
+        t.insert(t.end(), body.begin(), body.end());
+    }
+    SurfaceMesh mesh(p, t);
+    ASSERT_TRUE(validate_mesh(mesh).empty());
+    ASSERT_TRUE(is_intersection_free(mesh));
+    ASSERT_EQ(mesh.edge_triangles(mesh.find_edge(0, 1)).size(), 4u);
+    RemeshOptions options;
+    ImproveContext context;
+    context.xi = 1.0;
+    context.allow_topology_changes = false;
+    const FlipReport r = flip_edges(mesh, options, context);
+    EXPECT_GE(r.flips, 1);
+    EXPECT_TRUE(validate_mesh(mesh).empty());
+    EXPECT_TRUE(is_intersection_free(mesh));
+    // Each body flipped its own pair (the first flip on the non-manifold edge, the second on
+    // what was left of it): the bodies now meet only at vertices 0 and 1.
+    EXPECT_EQ(r.flips, 2);
+    EXPECT_EQ(mesh.find_edge(0, 1), INVALID_INDEX);
+    EXPECT_EQ(triangle_components(mesh).count, 2);
+}
+
 TEST(RemeshOptions, ValidateNamesTheField) {
     RemeshOptions o;
     EXPECT_NO_THROW(o.validate());
