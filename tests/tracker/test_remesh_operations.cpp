@@ -396,6 +396,31 @@ TEST(NullSpaceSmoothing, KeepsFacesRidgesAndCornersOfCubes) {
     EXPECT_TRUE(is_intersection_free(cubes));
 }
 
+TEST(Collapse, CoarseningCubesKeepsTheirCornersInPlace) {
+    SurfaceMesh cubes = testing::make_test_edge_sharing_cubes();
+    const FeatureThresholds thresholds;
+    std::vector<Vec3> corners;
+    for (int vi = 0; vi < cubes.num_vertices(); ++vi)
+        if (vertex_quadric(cubes, vi, thresholds).feature == VertexFeature::corner)
+            corners.push_back(cubes.position(vi));
+    ASSERT_GE(corners.size(), 14u);  // 2 × 8 cube corners, two of them shared
+    RemeshOptions options;
+    ImproveContext context;
+    context.xi = 1.8 * testing::mean_edge_length(cubes);
+    context.allow_topology_changes = false;
+    const CollapseReport r = collapse_short_edges(cubes, options, context);
+    EXPECT_GT(r.collapses, 0);
+    EXPECT_GT(r.feature_vertex_kept, 0);
+    EXPECT_TRUE(validate_mesh(cubes).empty());
+    EXPECT_TRUE(is_intersection_free(cubes));
+    for (const Vec3& c : corners) {
+        bool kept = false;
+        for (int vi = 0; vi < cubes.num_vertices(); ++vi)
+            kept = kept || (cubes.vertex_alive(vi) && cubes.position(vi) == c);
+        EXPECT_TRUE(kept) << "corner " << c.transpose() << " moved or vanished";
+    }
+}
+
 TEST(Flip, NonManifoldEdgeFlipsOnAConsistentlyOrientedPairOfOneBody) {
     // Two flat triangular bipyramids sharing their long edge (0, 1): four triangles on it.
     // Equator (0, 1, e), apexes c and d close to the edge's midpoint, so (0, 1) is far from

@@ -90,16 +90,30 @@ PlanCandidates plan_collapse(const SurfaceMesh& mesh, int ei, const RemeshOption
         out.plans.push_back(base);
         return out;
     }
-    const auto f0 = static_cast<int>(vertex_quadric(mesh, e[0], thresholds).feature);
-    const auto f1 = static_cast<int>(vertex_quadric(mesh, e[1], thresholds).feature);
-    Vec3 preferred;
-    if (f0 != f1) {
-        base.kept = f0 > f1 ? e[0] : e[1];
+    const VertexQuadric q0 = vertex_quadric(mesh, e[0], thresholds);
+    const VertexQuadric q1 = vertex_quadric(mesh, e[1], thresholds);
+    const auto f0 = static_cast<int>(q0.feature);
+    const auto f1 = static_cast<int>(q1.feature);
+    const bool both_corners = f0 == f1 && q0.feature == VertexFeature::corner;
+    if (f0 != f1 || both_corners) {
+        // The stronger feature stays put (§3.5.3); of two corners, the sharper one (larger
+        // smallest eigenvalue). Moving it towards the midpoint would defeat the purpose, so
+        // this is the only trajectory tried.
+        const bool keep0 = f0 != f1 ? f0 > f1 : q0.eigenvalues[2] >= q1.eigenvalues[2];
+        base.kept = keep0 ? e[0] : e[1];
         base.removed = mesh.other_vertex(ei, base.kept);
-        preferred = mesh.position(base.kept);
+        base.position = mesh.position(base.kept);
+        out.plans.push_back(base);
         out.feature_kept = true;
-    } else {
+        return out;
+    }
+    Vec3 preferred;
+    if (q0.feature == VertexFeature::smooth) {
         preferred = butterfly_point(mesh, ei).value_or(edge_midpoint(mesh, ei));
+    } else {
+        // Both on a ridge: the butterfly stencil reaches across the feature and would round it
+        // off; the midpoint stays on a straight ridge.
+        preferred = edge_midpoint(mesh, ei);
     }
     const Vec3 midpoint = edge_midpoint(mesh, ei);
     const int n = options.collapse_position_attempts;

@@ -1,9 +1,12 @@
 #pragma once
 /// \file Edge collapse (paper §3.5.3): edges shorter than β are replaced by one vertex. The new
 /// position is the butterfly point, except that a vertex on a ridge or corner (quadric metric
-/// tensor, quadric.h) keeps its place when the other end is less of a feature. Both endpoints
+/// tensor, quadric.h) keeps its place when the other end is less of a feature (of two corners,
+/// the sharper one), and an edge between two ridge vertices collapses to its midpoint (the
+/// butterfly stencil would reach across the feature and round it off). Both endpoints
 /// move there as a pseudo-motion checked by CCD; if it may collide, positions closer to the
-/// edge midpoint are tried, and if none is safe the collapse is abandoned. A collapse is also
+/// edge midpoint are tried (not when a feature vertex stays put), and if none is safe the
+/// collapse is abandoned. A collapse is also
 /// refused when it turns a triangle normal too far, changes the enclosed volume by more than
 /// γ (counting the motion of both endpoints), or — with topology changes off — would pinch the
 /// surface. Boundary and non-manifold edges are never collapsed (§3.5.3, §4.4).
