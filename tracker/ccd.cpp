@@ -23,6 +23,10 @@ constexpr double UNIT_ROUNDOFF = 0x1p-53;
 /// triangle) add <= 2 u D; the two subtractions add <= 2 u D and 3 u D. Total <= 26 u D + O(u^2).
 constexpr double CORNER_ERROR_FACTOR = 32.0 * UNIT_ROUNDOFF;
 /// Absolute allowance for gradual underflow (at most one half-spacing per rounding).
+/// Rounding allowance of the hull-separation pre-filter, in units of the machine epsilon
+/// times |n|₁ · max|x|: a dot product of three terms errs by at most ~3u of that, and the axis
+/// itself need not be exact (any direction separates or not), so 16 is generous.
+constexpr double HULL_ROUNDING_FACTOR = 16.0;
 constexpr double UNDERFLOW_ALLOWANCE = 64.0 * std::numeric_limits<double>::denorm_min();
 /// Parameter boxes are not split below this width, keeping every box corner an exact dyadic
 /// with few bits (so 1 - u and the bisection midpoints are exact).
@@ -379,6 +383,45 @@ void require_finite(std::initializer_list<const Eigen::Vector3d*> points, const 
     }
 }
 
+/// Sound early exit: true when some plane strictly separates the convex hulls of the two
+/// swept primitives. A linearly moving primitive stays inside the convex hull of its vertex
+/// positions at t = 0 and t = 1, so separated hulls can never touch. Projections are computed
+/// in floating point and the separation must exceed a bound on their rounding error
+/// (HULL_ROUNDING_FACTOR · u · |n|₁ · max |coordinate|), so rounding can only make this say
+/// "not separated". Axes are chosen by the caller (plane normals and edge-pair normals at
+/// several times); a zero axis is skipped.
+template <size_t N, size_t M>
+bool hulls_separated(const std::array<const Eigen::Vector3d*, N>& first,
+                     const std::array<const Eigen::Vector3d*, M>& second,
+                     std::initializer_list<Eigen::Vector3d> axes) {
+    double coordinate_bound = 0.0;
+    for (const Eigen::Vector3d* p : first)
+        coordinate_bound = std::max(coordinate_bound, p->cwiseAbs().maxCoeff());
+    for (const Eigen::Vector3d* p : second)
+        coordinate_bound = std::max(coordinate_bound, p->cwiseAbs().maxCoeff());
+    for (const Eigen::Vector3d& n : axes) {
+        if (!n.allFinite() || n.isZero(0.0))
+            continue;
+        const double margin = HULL_ROUNDING_FACTOR * std::numeric_limits<double>::epsilon() *
+                                  n.cwiseAbs().sum() * coordinate_bound +
+                              UNDERFLOW_ALLOWANCE;
+        double lo1 = std::numeric_limits<double>::infinity(), hi1 = -lo1, lo2 = lo1, hi2 = -lo1;
+        for (const Eigen::Vector3d* p : first) {
+            const double s = n.dot(*p);
+            lo1 = std::min(lo1, s);
+            hi1 = std::max(hi1, s);
+        }
+        for (const Eigen::Vector3d* p : second) {
+            const double s = n.dot(*p);
+            lo2 = std::min(lo2, s);
+            hi2 = std::max(hi2, s);
+        }
+        if (hi1 + margin < lo2 || hi2 + margin < lo1)
+            return true;
+    }
+    return false;
+}
+
 SearchResult point_triangle_search(const Eigen::Vector3d& p_t0, const Eigen::Vector3d& a_t0,
                                    const Eigen::Vector3d& b_t0, const Eigen::Vector3d& c_t0,
                                    const Eigen::Vector3d& p_t1, const Eigen::Vector3d& a_t1,
@@ -396,6 +439,14 @@ SearchResult point_triangle_search(const Eigen::Vector3d& p_t0, const Eigen::Vec
     const Eigen::Vector3d& a1 = *v1[order[0]];
     const Eigen::Vector3d& b1 = *v1[order[1]];
     const Eigen::Vector3d& c1 = *v1[order[2]];
+    {
+        const Eigen::Vector3d am = 0.5 * (a0 + a1), bm = 0.5 * (b0 + b1), cm = 0.5 * (c0 + c1);
+        if (hulls_separated<2, 6>(
+                {&p_t0, &p_t1}, {&a0, &b0, &c0, &a1, &b1, &c1},
+                {(b0 - a0).cross(c0 - a0), (b1 - a1).cross(c1 - a1), (bm - am).cross(cm - am)})) {
+            return SearchResult{};
+        }
+    }
     const GapFunction f = make_gap_function({p_t0 - a0, b0 - a0, c0 - a0},
                                             {p_t1 - a1, b1 - a1, c1 - a1}, true, options);
     return search(f, options, earliest);
@@ -436,6 +487,15 @@ SearchResult edge_edge_search(const Eigen::Vector3d& ea0_t0, const Eigen::Vector
     const Eigen::Vector3d& a1e = *ea.second.x1;
     const Eigen::Vector3d& b0e = *eb.first.x1;
     const Eigen::Vector3d& b1e = *eb.second.x1;
+    {
+        const Eigen::Vector3d da_m = 0.5 * ((a1 - a0) + (a1e - a0e));
+        const Eigen::Vector3d db_m = 0.5 * ((b1 - b0) + (b1e - b0e));
+        if (hulls_separated<4, 4>(
+                {&a0, &a1, &a0e, &a1e}, {&b0, &b1, &b0e, &b1e},
+                {(a1 - a0).cross(b1 - b0), (a1e - a0e).cross(b1e - b0e), da_m.cross(db_m)})) {
+            return SearchResult{};
+        }
+    }
     // F = (ea0 - eb0) - u (ea0 - ea1) - v (eb1 - eb0) = [ea0 + u (ea1 - ea0)] - [eb0 + v (eb1 -
     // eb0)]
     const GapFunction f = make_gap_function({a0 - b0, a0 - a1, b1 - b0},

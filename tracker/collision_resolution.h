@@ -22,23 +22,23 @@ namespace meniscus::tracker {
 /// Options of collision resolution. Distances are absolute (metres); the SurfaceTracker
 /// derives them from fractions of the mesh's initial mean edge length ξ.
 struct CollisionOptions {
-    double proximity_epsilon = 1e-5;   ///< ε_p: repulsion distance (m), > 0
-    bool repulsion = true;             ///< phase (1) on/off
-    int impulse_sweeps = 3;            ///< phase (2) sweeps (paper: 3), ≥ 0
+    double proximity_epsilon = 1e-5;      ///< ε_p: repulsion distance (m), > 0
+    bool repulsion = true;                ///< phase (1) on/off
+    int impulse_sweeps = 3;               ///< phase (2) sweeps (paper: 3), ≥ 0
     int max_impact_zone_iterations = 64;  ///< phase (3) detect/solve rounds, ≥ 1
     int max_rigid_zone_iterations = 16;   ///< phase (4a) rounds, ≥ 0
     int max_step_shortenings = 10;        ///< phase (4b): halvings of the remaining motion, ≥ 0
-    void validate() const;  ///< throws std::invalid_argument naming the field
+    void validate() const;                ///< throws std::invalid_argument naming the field
 };
 
 /// What collision resolution did.
 struct CollisionReport {
-    int proximities = 0;            ///< pairs closer than ε_p at t0 (repulsion applied)
-    int collisions_first_sweep = 0; ///< CCD hits in the first impulse sweep
-    int impulses = 0;               ///< individual CCD impulses applied
+    int proximities = 0;             ///< pairs closer than ε_p at t0 (repulsion applied)
+    int collisions_first_sweep = 0;  ///< CCD hits in the first impulse sweep
+    int impulses = 0;                ///< individual CCD impulses applied
     int impact_zone_iterations = 0;
-    int impact_zones = 0;           ///< zones in the last impact-zone round
-    int largest_impact_zone = 0;    ///< vertices in the largest zone
+    int impact_zones = 0;         ///< zones in the last impact-zone round
+    int largest_impact_zone = 0;  ///< vertices in the largest zone
     int rigid_zone_iterations = 0;
     int step_shortenings = 0;
     /// Fraction of the requested motion actually applied (1 unless step shortening was used;
@@ -50,10 +50,11 @@ struct CollisionReport {
 };
 
 /// Makes the motion x_t0 → x_t1 collision-free by changing x_t1 (both sized
-/// mesh.num_vertices(); dead slots ignored). `dt` > 0 scales velocities for the repulsion
-/// target (u = (x_t1 − x_t0)/dt). `masses` (optional, > 0 per vertex) weight the impulses
-/// (M = I when null); `pinned` (optional) vertices never move. x_t0 must be intersection-free
-/// for the guarantee to hold. Throws std::invalid_argument on size mismatch or bad options.
+/// mesh.num_vertices(); dead slots ignored). `dt` > 0 is the step's duration; everything is
+/// computed on displacements x_t1 − x_t0 (velocity · dt), so only they matter. `masses` (optional,
+/// > 0 per vertex) weight the impulses (M = I when null); `pinned` (optional) vertices never move.
+/// x_t0 must be intersection-free for the guarantee to hold. Throws std::invalid_argument on size
+/// mismatch or bad options.
 CollisionReport resolve_collisions(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
                                    std::vector<Vec3>& x_t1, double dt,
                                    const CollisionOptions& options,

@@ -1,0 +1,203 @@
+#include "tracker/collision_resolution.h"
+#include "tracker/implicit_mesher.h"
+#include "tracker/mesh_intersections.h"
+#include "tracker/mesh_measures.h"
+#include "tracker/surface_tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace meniscus::tracker {
+namespace {
+
+SurfaceMesh meshed(const ShapePtr& shape, double h) {
+    ImplicitMeshOptions o;
+    o.edge_length = h;
+    return mesh_implicit_shape(*shape, o);
+}
+
+/// Meshes each shape separately and puts them in one mesh (they may be closer than an edge).
+SurfaceMesh meshed_apart(const std::vector<ShapePtr>& shapes, double h) {
+    std::vector<Vec3> x;
+    std::vector<Triangle> t;
+    for (const ShapePtr& shape : shapes) {
+        const SurfaceMesh m = meshed(shape, h);
+        const int offset = static_cast<int>(x.size());
+        x.insert(x.end(), m.positions().begin(), m.positions().end());
+        for (int ti = 0; ti < m.num_triangles(); ++ti) {
+            Triangle tri = m.triangle(ti);
+            for (int& v : tri)
+                v += offset;
+            t.push_back(tri);
+        }
+    }
+    return SurfaceMesh(x, t);
+}
+
+TrackerOptions verified() {
+    TrackerOptions o;
+    o.verify_intersection_free = true;
+    return o;
+}
+
+TEST(CollisionResolution, PointDrivenThroughTriangleIsStopped) {
+    // A tetrahedron and a small tetrahedron above it driven straight down through it.
+    SurfaceMesh m(
+        {{0, 0, 0},
+         {1, 0, 0},
+         {0, 1, 0},
+         {0.3, 0.3, -1},
+         {0.2, 0.2, 0.1},
+         {0.3, 0.2, 0.3},
+         {0.2, 0.3, 0.3},
+         {0.25, 0.25, 0.5}},
+        {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}, {4, 6, 5}, {4, 5, 7}, {5, 6, 7}, {6, 4, 7}});
+    ASSERT_TRUE(is_intersection_free(m));
+    std::vector<Vec3> x1 = m.positions();
+    for (int v = 4; v < 8; ++v)
+        x1[static_cast<size_t>(v)].z() -= 1.0;
+    EXPECT_FALSE(motion_is_collision_free(m, m.positions(), x1));
+    CollisionOptions o;
+    o.proximity_epsilon = 1e-4;
+    const CollisionReport r = resolve_collisions(m, m.positions(), x1, 1.0, o);
+    EXPECT_GT(r.collisions_first_sweep, 0);
+    EXPECT_TRUE(motion_is_collision_free(m, m.positions(), x1));
+    EXPECT_TRUE(is_intersection_free(m, &x1));
+    // Momentum is shared (equal masses): the big tetrahedron is pushed down too, but the small
+    // one's lowest vertex ends above the big one's top face.
+    EXPECT_GE(x1[4].z(), x1[0].z());
+    EXPECT_LT(x1[0].z(), -0.1);
+}
+
+TEST(CollisionResolution, PinnedVerticesDoNotMove) {
+    SurfaceMesh m(
+        {{0, 0, 0},
+         {1, 0, 0},
+         {0, 1, 0},
+         {0.3, 0.3, -1},
+         {0.2, 0.2, 0.1},
+         {0.3, 0.2, 0.3},
+         {0.2, 0.3, 0.3},
+         {0.25, 0.25, 0.5}},
+        {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}, {4, 6, 5}, {4, 5, 7}, {5, 6, 7}, {6, 4, 7}});
+    std::vector<Vec3> x1 = m.positions();
+    for (int v = 4; v < 8; ++v)
+        x1[static_cast<size_t>(v)].z() -= 1.0;
+    std::vector<std::uint8_t> pinned(8, 0);
+    for (int v = 0; v < 4; ++v)
+        pinned[static_cast<size_t>(v)] = 1;
+    CollisionOptions o;
+    resolve_collisions(m, m.positions(), x1, 1.0, o, nullptr, &pinned);
+    for (int v = 0; v < 4; ++v)
+        EXPECT_EQ(x1[static_cast<size_t>(v)], m.position(v));
+    EXPECT_TRUE(motion_is_collision_free(m, m.positions(), x1));
+}
+
+TEST(CollisionResolution, RejectsBadInput) {
+    SurfaceMesh m({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
+    std::vector<Vec3> x1(2);
+    CollisionOptions o;
+    EXPECT_THROW(resolve_collisions(m, m.positions(), x1, 1.0, o), std::invalid_argument);
+    x1 = m.positions();
+    EXPECT_THROW(resolve_collisions(m, m.positions(), x1, 0.0, o), std::invalid_argument);
+    o.impulse_sweeps = -1;
+    EXPECT_THROW(resolve_collisions(m, m.positions(), x1, 1.0, o), std::invalid_argument);
+}
+
+/// Stress: two spheres driven head-on for many steps (no remeshing): they flatten against each
+/// other and never intersect.
+TEST(CollisionStress, SpheresDrivenHeadOn) {
+    SurfaceTracker tracker(
+        meshed_apart({make_sphere({-0.21, 0, 0}, 0.2), make_sphere({0.21, 0, 0}, 0.2)}, 0.06),
+        verified());
+    const SurfaceMesh& m = tracker.mesh();
+    const double speed = 0.5, dt = 0.01;  // 0.005 per step: a twelfth of an edge
+    int total_collisions = 0;
+    for (int step = 0; step < 120; ++step) {
+        std::vector<Vec3> v(static_cast<size_t>(m.num_vertices()));
+        for (int vi = 0; vi < m.num_vertices(); ++vi)
+            v[static_cast<size_t>(vi)] = Vec3(m.position(vi).x() < 0 ? speed : -speed, 0, 0);
+        const IntegrateResult r = tracker.integrate(v, dt);
+        ASSERT_EQ(r.intersecting_pairs, 0) << "step " << step;
+        total_collisions += r.collisions.collisions_first_sweep + r.collisions.proximities;
+    }
+    EXPECT_GT(total_collisions, 100);
+    // Nothing crossed x = 0 from either side.
+    EXPECT_TRUE(is_intersection_free(m));
+}
+
+/// Stress: two thin slabs sheared past each other while pressed together (every step has the
+/// whole contact face in contact: the heavy version is bench_tracker's).
+TEST(CollisionStress, SheetsShearedPastEachOther) {
+    SurfaceTracker tracker(meshed_apart({make_box({-0.4, -0.4, 0.005}, {0.4, 0.4, 0.045}),
+                                         make_box({-0.4, -0.4, -0.045}, {0.4, 0.4, -0.005})},
+                                        0.08),
+                           verified());
+    const SurfaceMesh& m = tracker.mesh();
+    ASSERT_EQ(triangle_components(m).count, 2);
+    // Which slab each vertex belongs to, fixed at the start (vertices may cross z = 0 later).
+    std::vector<std::uint8_t> upper(static_cast<size_t>(m.num_vertices()));
+    for (int vi = 0; vi < m.num_vertices(); ++vi)
+        upper[static_cast<size_t>(vi)] = m.position(vi).z() > 0;
+    std::mt19937 rng(3);
+    std::normal_distribution<double> jitter(0.0, 0.2);
+    for (int step = 0; step < 60; ++step) {
+        std::vector<Vec3> v(static_cast<size_t>(m.num_vertices()));
+        for (int vi = 0; vi < m.num_vertices(); ++vi) {
+            const bool up = upper[static_cast<size_t>(vi)];
+            v[static_cast<size_t>(vi)] = Vec3(up ? 1.0 : -1.0, jitter(rng), up ? -0.2 : 0.2);
+        }
+        const IntegrateResult r = tracker.integrate(v, 0.005);
+        ASSERT_EQ(r.intersecting_pairs, 0) << "step " << step;
+    }
+    // They slid past each other (frictionless contact keeps most of the tangential motion).
+    double upper_x = 0.0;
+    int upper_n = 0;
+    for (int vi = 0; vi < m.num_vertices(); ++vi)
+        if (upper[static_cast<size_t>(vi)]) {
+            upper_x += m.position(vi).x();
+            ++upper_n;
+        }
+    EXPECT_GT(upper_x / upper_n, 0.1);
+}
+
+/// Stress: a sphere crushed by a random velocity field (large random motion per vertex).
+TEST(CollisionStress, SphereCrushedByRandomField) {
+    SurfaceTracker tracker(meshed(make_sphere({0, 0, 0}, 0.3), 0.1), verified());
+    const SurfaceMesh& m = tracker.mesh();
+    std::mt19937 rng(11);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    int shortened = 0;
+    for (int step = 0; step < 1000; ++step) {
+        std::vector<Vec3> v(static_cast<size_t>(m.num_vertices()));
+        for (int vi = 0; vi < m.num_vertices(); ++vi)
+            v[static_cast<size_t>(vi)] =
+                -2.0 * m.position(vi) + Vec3(noise(rng), noise(rng), noise(rng));
+        const IntegrateResult r = tracker.integrate(v, 0.01);
+        ASSERT_EQ(r.intersecting_pairs, 0) << "step " << step;
+        shortened += r.collisions.step_shortenings;
+    }
+    // It was crushed: much smaller than it started.
+    EXPECT_LT(std::abs(enclosed_volume(m)), 0.5 * 4.0 / 3.0 * M_PI * 0.027);
+    RecordProperty("step_shortenings", shortened);
+}
+
+TEST(CollisionStress, WithoutSafetyTheSameMotionIntersects) {
+    TrackerOptions o = verified();
+    o.collision_safety = false;
+    SurfaceTracker tracker(
+        meshed_apart({make_sphere({-0.21, 0, 0}, 0.2), make_sphere({0.21, 0, 0}, 0.2)}, 0.05), o);
+    const SurfaceMesh& m = tracker.mesh();
+    int worst = 0;
+    for (int step = 0; step < 20; ++step) {
+        std::vector<Vec3> v(static_cast<size_t>(m.num_vertices()));
+        for (int vi = 0; vi < m.num_vertices(); ++vi)
+            v[static_cast<size_t>(vi)] = Vec3(m.position(vi).x() < 0 ? 0.5 : -0.5, 0, 0);
+        worst = std::max(worst, tracker.integrate(v, 0.01).intersecting_pairs);
+    }
+    EXPECT_GT(worst, 0);
+}
+
+}  // namespace
+}  // namespace meniscus::tracker

@@ -1,0 +1,472 @@
+#include "tracker/collision_resolution.h"
+
+#include "tracker/broadphase.h"
+#include "tracker/ccd.h"
+#include "tracker/distance.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace meniscus::tracker {
+
+namespace {
+
+/// Grain of the parallel CCD loops.
+constexpr size_t PARALLEL_GRAIN = 64;
+/// CCD impulses aim for this fraction of ε_p of separating normal displacement, so that a
+/// resolved pair does not end the step exactly touching.
+constexpr double IMPULSE_SEPARATION_FRACTION = 0.1;
+/// Relative Tikhonov regularization of the impact-zone system (redundant constraints make
+/// C M⁻¹ Cᵀ singular).
+constexpr double ZONE_REGULARIZATION = 1e-12;
+
+/// One possible contact between four vertices with weights ā (Σ āᵢ xᵢ = separation vector) and
+/// a unit normal n: the constraint row is āᵢ nᵀ per vertex.
+struct Contact {
+    std::array<int, 4> vertices;
+    std::array<double, 4> weights;
+    Vec3 normal;
+    double target = 0.0;  ///< desired n · Σ āᵢ dᵢ (relative normal displacement), metres
+};
+
+/// Inverse masses (0 for pinned vertices).
+std::vector<double> inverse_masses(const SurfaceMesh& mesh, const std::vector<double>* masses,
+                                   const std::vector<std::uint8_t>* pinned) {
+    const size_t n = static_cast<size_t>(mesh.num_vertices());
+    if (masses && masses->size() != n)
+        throw std::invalid_argument("resolve_collisions: masses has " +
+                                    std::to_string(masses->size()) + " entries for " +
+                                    std::to_string(n) + " vertices");
+    if (pinned && pinned->size() != n)
+        throw std::invalid_argument("resolve_collisions: pinned has " +
+                                    std::to_string(pinned->size()) + " entries for " +
+                                    std::to_string(n) + " vertices");
+    std::vector<double> w(n, 1.0);
+    for (size_t i = 0; i < n; ++i) {
+        if (masses) {
+            if (!((*masses)[i] > 0.0))
+                throw std::invalid_argument("resolve_collisions: masses must be > 0");
+            w[i] = 1.0 / (*masses)[i];
+        }
+        if (pinned && (*pinned)[i])
+            w[i] = 0.0;
+    }
+    return w;
+}
+
+double relative_normal_displacement(const Contact& c, const std::vector<Vec3>& d) {
+    Vec3 rel = Vec3::Zero();
+    for (int k = 0; k < 4; ++k)
+        rel += c.weights[k] * d[static_cast<size_t>(c.vertices[k])];
+    return c.normal.dot(rel);
+}
+
+/// Applies the impulse that raises the contact's relative normal displacement to its target
+/// (no-op when already there). Returns true if it changed anything.
+bool apply_impulse(const Contact& c, const std::vector<double>& inv_mass, std::vector<Vec3>& d) {
+    const double delta = c.target - relative_normal_displacement(c, d);
+    if (!(delta > 0.0))
+        return false;
+    double denom = 0.0;
+    for (int k = 0; k < 4; ++k)
+        denom += c.weights[k] * c.weights[k] * inv_mass[static_cast<size_t>(c.vertices[k])];
+    if (!(denom > 0.0))
+        return false;  // every vertex pinned: nothing can move
+    const double j = delta / denom;
+    for (int k = 0; k < 4; ++k) {
+        const auto v = static_cast<size_t>(c.vertices[k]);
+        d[v] += (j * c.weights[k] * inv_mass[v]) * c.normal;
+    }
+    return true;
+}
+
+class Resolver {
+public:
+    Resolver(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0, const CollisionOptions& o,
+             std::vector<double> inv_mass)
+        : m_mesh(mesh), m_x0(x_t0), m_o(o), m_inv_mass(std::move(inv_mass)) {}
+
+    /// Phase 1: proximity repulsion at t0 (paper: push apart to ε_p over the step).
+    int repel(std::vector<Vec3>& d) const {
+        const BroadPhase broad(m_mesh, m_x0, m_x0, 0.5 * m_o.proximity_epsilon);
+        std::vector<Contact> contacts;
+        for (const VertexTrianglePair& p : broad.vertex_triangle_pairs()) {
+            const Triangle& t = m_mesh.triangle(p.ti);
+            const auto prox = point_triangle_proximity(x0(p.vi), x0(t[0]), x0(t[1]), x0(t[2]));
+            if (prox.distance < m_o.proximity_epsilon)
+                contacts.push_back({{p.vi, t[0], t[1], t[2]},
+                                    prox.weights,
+                                    prox.normal,
+                                    m_o.proximity_epsilon - prox.distance});
+        }
+        for (const EdgeEdgePair& p : broad.edge_edge_pairs()) {
+            const Edge& a = m_mesh.edge(p.ei);
+            const Edge& b = m_mesh.edge(p.ej);
+            const auto prox = edge_edge_proximity(x0(a[0]), x0(a[1]), x0(b[0]), x0(b[1]));
+            if (prox.distance < m_o.proximity_epsilon)
+                contacts.push_back({{a[0], a[1], b[0], b[1]},
+                                    prox.weights,
+                                    prox.normal,
+                                    m_o.proximity_epsilon - prox.distance});
+        }
+        for (const Contact& c : contacts)
+            apply_impulse(c, m_inv_mass, d);
+        return static_cast<int>(contacts.size());
+    }
+
+    /// Every possible collision of the motion x0 → x0 + d (exact broad phase + CCD).
+    std::vector<Contact> detect(const std::vector<Vec3>& d) const {
+        std::vector<Vec3> x1(m_x0.size());
+        for (size_t i = 0; i < x1.size(); ++i)
+            x1[i] = m_x0[i] + d[i];
+        const BroadPhase broad(m_mesh, m_x0, x1, 0.0);
+        const auto vt = broad.vertex_triangle_pairs();
+        const auto ee = broad.edge_edge_pairs();
+        tbb::enumerable_thread_specific<std::vector<Contact>> local;
+        const double target = IMPULSE_SEPARATION_FRACTION * m_o.proximity_epsilon;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, vt.size() + ee.size(), PARALLEL_GRAIN),
+                          [&](const tbb::blocked_range<size_t>& r) {
+                              auto& out = local.local();
+                              for (size_t i = r.begin(); i < r.end(); ++i) {
+                                  if (i < vt.size()) {
+                                      const VertexTrianglePair& p = vt[i];
+                                      const Triangle& t = m_mesh.triangle(p.ti);
+                                      const std::array<int, 4> v = {p.vi, t[0], t[1], t[2]};
+                                      test(v, x1, false, target, out);
+                                  } else {
+                                      const EdgeEdgePair& p = ee[i - vt.size()];
+                                      const Edge& a = m_mesh.edge(p.ei);
+                                      const Edge& b = m_mesh.edge(p.ej);
+                                      const std::array<int, 4> v = {a[0], a[1], b[0], b[1]};
+                                      test(v, x1, true, target, out);
+                                  }
+                              }
+                          });
+        std::vector<Contact> all;
+        for (auto& part : local)
+            all.insert(all.end(), part.begin(), part.end());
+        // Deterministic order regardless of threading.
+        std::sort(all.begin(), all.end(),
+                  [](const Contact& a, const Contact& b) { return a.vertices < b.vertices; });
+        return all;
+    }
+
+    /// Phase 3: impact zones (Harmon et al. 2008 inelastic projection, paper §3.8).
+    /// Returns true when the motion is collision-free at the end.
+    bool impact_zones(std::vector<Vec3>& d, CollisionReport& report) const {
+        std::vector<Contact> constraints;
+        for (int it = 0; it < m_o.max_impact_zone_iterations; ++it) {
+            std::vector<Contact> fresh = detect(d);
+            if (fresh.empty())
+                return true;
+            ++report.impact_zone_iterations;
+            constraints.insert(constraints.end(), fresh.begin(), fresh.end());
+            solve_zones(constraints, d, report);
+        }
+        return detect(d).empty();
+    }
+
+    /// Phase 4a: rigid impact zones (Bridson et al. 2002): every zone moves with the mean
+    /// linear and angular momentum of its vertices; zones merge as new collisions appear.
+    /// The linear interpolation of a rigid velocity field is an affine map with determinant
+    /// 1 + t²|ω|² > 0, so a zone never collides with itself.
+    bool rigid_zones(std::vector<Vec3>& d, CollisionReport& report) const {
+        std::vector<int> parent(m_x0.size());
+        std::iota(parent.begin(), parent.end(), 0);
+        std::vector<std::uint8_t> in_zone(m_x0.size(), 0);
+        for (int it = 0; it < m_o.max_rigid_zone_iterations; ++it) {
+            const std::vector<Contact> fresh = detect(d);
+            if (fresh.empty())
+                return true;
+            ++report.rigid_zone_iterations;
+            for (const Contact& c : fresh)
+                for (int k = 0; k < 4; ++k) {
+                    in_zone[static_cast<size_t>(c.vertices[k])] = 1;
+                    unite(parent, c.vertices[0], c.vertices[k]);
+                }
+            make_rigid(parent, in_zone, d);
+        }
+        return detect(d).empty();
+    }
+
+private:
+    const Vec3& x0(int vi) const { return m_x0[static_cast<size_t>(vi)]; }
+
+    void test(const std::array<int, 4>& v, const std::vector<Vec3>& x1, bool edge_edge,
+              double target, std::vector<Contact>& out) const {
+        const auto p0 = [&](int k) -> const Vec3& { return m_x0[static_cast<size_t>(v[k])]; };
+        const auto p1 = [&](int k) -> const Vec3& { return x1[static_cast<size_t>(v[k])]; };
+        const bool hit =
+            edge_edge ? edge_edge_ccd(p0(0), p0(1), p0(2), p0(3), p1(0), p1(1), p1(2), p1(3))
+                      : point_triangle_ccd(p0(0), p0(1), p0(2), p0(3), p1(0), p1(1), p1(2), p1(3));
+        if (!hit)
+            return;
+        const CcdResult r = edge_edge ? edge_edge_ccd_detailed(p0(0), p0(1), p0(2), p0(3), p1(0),
+                                                               p1(1), p1(2), p1(3))
+                                      : point_triangle_ccd_detailed(p0(0), p0(1), p0(2), p0(3),
+                                                                    p1(0), p1(1), p1(2), p1(3));
+        out.push_back({v, r.weights, r.normal, target});
+    }
+
+    static int find(std::vector<int>& parent, int v) {
+        while (parent[static_cast<size_t>(v)] != v) {
+            parent[static_cast<size_t>(v)] =
+                parent[static_cast<size_t>(parent[static_cast<size_t>(v)])];
+            v = parent[static_cast<size_t>(v)];
+        }
+        return v;
+    }
+    static void unite(std::vector<int>& parent, int a, int b) {
+        a = find(parent, a);
+        b = find(parent, b);
+        if (a != b)
+            parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+    }
+
+    /// Groups constraints into zones of vertex-connected contacts and solves each zone:
+    /// d ← d + M⁻¹ Cᵀ λ with (C M⁻¹ Cᵀ) λ = b − C d.
+    void solve_zones(const std::vector<Contact>& constraints, std::vector<Vec3>& d,
+                     CollisionReport& report) const {
+        std::vector<int> parent(m_x0.size());
+        std::iota(parent.begin(), parent.end(), 0);
+        for (const Contact& c : constraints)
+            for (int k = 1; k < 4; ++k)
+                unite(parent, c.vertices[0], c.vertices[k]);
+        std::vector<std::vector<int>> zone_rows;
+        std::vector<int> zone_of_root(m_x0.size(), -1);
+        for (size_t i = 0; i < constraints.size(); ++i) {
+            const int root = find(parent, constraints[i].vertices[0]);
+            int& z = zone_of_root[static_cast<size_t>(root)];
+            if (z < 0) {
+                z = static_cast<int>(zone_rows.size());
+                zone_rows.emplace_back();
+            }
+            zone_rows[static_cast<size_t>(z)].push_back(static_cast<int>(i));
+        }
+        report.impact_zones = static_cast<int>(zone_rows.size());
+        for (const std::vector<int>& rows : zone_rows)
+            solve_zone(constraints, rows, d, report);
+    }
+
+    /// One zone: A = C M⁻¹ Cᵀ is assembled sparse — rows r and s couple only through the
+    /// vertices they share, A_rs = Σ_v ā_rv ā_sv m_v⁻¹ (n_r · n_s) — and factored by sparse LDLᵀ.
+    void solve_zone(const std::vector<Contact>& constraints, const std::vector<int>& rows,
+                    std::vector<Vec3>& d, CollisionReport& report) const {
+        const int m = static_cast<int>(rows.size());
+        // Rows touching each vertex, with the row's weight for it.
+        std::vector<std::pair<int, std::pair<int, double>>> touches;  // (vertex, (row, ā))
+        touches.reserve(4 * rows.size());
+        Eigen::VectorXd rhs(m);
+        for (int r = 0; r < m; ++r) {
+            const Contact& c = constraints[static_cast<size_t>(rows[static_cast<size_t>(r)])];
+            for (int k = 0; k < 4; ++k)
+                touches.push_back({c.vertices[k], {r, c.weights[k]}});
+            rhs[r] = c.target - relative_normal_displacement(c, d);
+        }
+        std::sort(touches.begin(), touches.end());
+        int zone_vertices = 0;
+        std::vector<Eigen::Triplet<double>> entries;
+        for (size_t a = 0; a < touches.size();) {
+            size_t b = a;
+            while (b < touches.size() && touches[b].first == touches[a].first)
+                ++b;
+            ++zone_vertices;
+            const double inv = m_inv_mass[static_cast<size_t>(touches[a].first)];
+            if (inv > 0.0) {
+                for (size_t i = a; i < b; ++i)
+                    for (size_t j = a; j < b; ++j) {
+                        const int ri = touches[i].second.first, rj = touches[j].second.first;
+                        const Vec3& ni = constraint(constraints, rows, ri).normal;
+                        const Vec3& nj = constraint(constraints, rows, rj).normal;
+                        entries.emplace_back(
+                            ri, rj,
+                            touches[i].second.second * touches[j].second.second * inv * ni.dot(nj));
+                    }
+            }
+            a = b;
+        }
+        report.largest_impact_zone = std::max(report.largest_impact_zone, zone_vertices);
+        Eigen::SparseMatrix<double> A(m, m);
+        A.setFromTriplets(entries.begin(), entries.end());
+        double scale = 0.0;
+        for (int r = 0; r < m; ++r)
+            scale = std::max(scale, A.coeff(r, r));
+        if (!(scale > 0.0))
+            return;  // every vertex pinned
+        for (int r = 0; r < m; ++r)
+            A.coeffRef(r, r) += ZONE_REGULARIZATION * scale;
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(A);
+        if (ldlt.info() != Eigen::Success)
+            return;  // left to the rigid-zone fallback
+        const Eigen::VectorXd lambda = ldlt.solve(rhs);
+        // d ← d + M⁻¹ Cᵀ λ.
+        for (int r = 0; r < m; ++r) {
+            const Contact& c = constraint(constraints, rows, r);
+            for (int k = 0; k < 4; ++k) {
+                const auto v = static_cast<size_t>(c.vertices[k]);
+                d[v] += (lambda[r] * c.weights[k] * m_inv_mass[v]) * c.normal;
+            }
+        }
+    }
+
+    static const Contact& constraint(const std::vector<Contact>& constraints,
+                                     const std::vector<int>& rows, int r) {
+        return constraints[static_cast<size_t>(rows[static_cast<size_t>(r)])];
+    }
+
+    void make_rigid(std::vector<int>& parent, const std::vector<std::uint8_t>& in_zone,
+                    std::vector<Vec3>& d) const {
+        std::vector<std::vector<int>> zones;
+        std::vector<int> zone_of_root(m_x0.size(), -1);
+        for (size_t v = 0; v < m_x0.size(); ++v) {
+            if (!in_zone[v])
+                continue;
+            const int root = find(parent, static_cast<int>(v));
+            int& z = zone_of_root[static_cast<size_t>(root)];
+            if (z < 0) {
+                z = static_cast<int>(zones.size());
+                zones.emplace_back();
+            }
+            zones[static_cast<size_t>(z)].push_back(static_cast<int>(v));
+        }
+        for (const std::vector<int>& zone : zones) {
+            bool any_pinned = false;
+            for (int v : zone)
+                any_pinned = any_pinned || m_inv_mass[static_cast<size_t>(v)] == 0.0;
+            if (any_pinned) {
+                // A pinned vertex pins its whole zone.
+                for (int v : zone)
+                    d[static_cast<size_t>(v)].setZero();
+                continue;
+            }
+            double mass = 0.0;
+            Vec3 com = Vec3::Zero(), momentum = Vec3::Zero();
+            for (int v : zone) {
+                const double mv = 1.0 / m_inv_mass[static_cast<size_t>(v)];
+                mass += mv;
+                com += mv * x0(v);
+                momentum += mv * d[static_cast<size_t>(v)];
+            }
+            com /= mass;
+            const Vec3 linear = momentum / mass;
+            Vec3 angular = Vec3::Zero();
+            Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+            for (int v : zone) {
+                const double mv = 1.0 / m_inv_mass[static_cast<size_t>(v)];
+                const Vec3 r = x0(v) - com;
+                angular += mv * r.cross(d[static_cast<size_t>(v)] - linear);
+                inertia += mv * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+            }
+            const Vec3 omega = inertia.completeOrthogonalDecomposition().solve(angular);
+            for (int v : zone)
+                d[static_cast<size_t>(v)] = linear + omega.cross(x0(v) - com);
+        }
+    }
+
+    const SurfaceMesh& m_mesh;
+    const std::vector<Vec3>& m_x0;
+    const CollisionOptions& m_o;
+    std::vector<double> m_inv_mass;
+};
+
+}  // namespace
+
+void CollisionOptions::validate() const {
+    if (!(proximity_epsilon > 0.0) || !std::isfinite(proximity_epsilon))
+        throw std::invalid_argument("proximity_epsilon: expected a number > 0");
+    if (impulse_sweeps < 0)
+        throw std::invalid_argument("impulse_sweeps: expected an integer >= 0");
+    if (max_impact_zone_iterations < 1)
+        throw std::invalid_argument("max_impact_zone_iterations: expected an integer >= 1");
+    if (max_rigid_zone_iterations < 0)
+        throw std::invalid_argument("max_rigid_zone_iterations: expected an integer >= 0");
+    if (max_step_shortenings < 0)
+        throw std::invalid_argument("max_step_shortenings: expected an integer >= 0");
+}
+
+CollisionReport resolve_collisions(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
+                                   std::vector<Vec3>& x_t1, double dt,
+                                   const CollisionOptions& options,
+                                   const std::vector<double>* masses,
+                                   const std::vector<std::uint8_t>* pinned) {
+    options.validate();
+    const size_t n = static_cast<size_t>(mesh.num_vertices());
+    if (x_t0.size() != n || x_t1.size() != n)
+        throw std::invalid_argument("resolve_collisions: " + std::to_string(x_t0.size()) + " and " +
+                                    std::to_string(x_t1.size()) + " positions for " +
+                                    std::to_string(n) + " vertices");
+    if (!(dt > 0.0) || !std::isfinite(dt))
+        throw std::invalid_argument("resolve_collisions: dt must be a finite number > 0");
+    const std::vector<double> inv = inverse_masses(mesh, masses, pinned);
+    const Resolver resolver(mesh, x_t0, options, inv);
+
+    // Work with displacements d = x_t1 − x_t0 (velocities times dt).
+    std::vector<Vec3> d(n);
+    for (size_t i = 0; i < n; ++i)
+        d[i] = x_t1[i] - x_t0[i];
+    const std::vector<Vec3> requested = d;
+    CollisionReport report;
+
+    if (options.repulsion)
+        report.proximities = resolver.repel(d);
+
+    // Phase 2: sweeps of individual impulses.
+    for (int sweep = 0; sweep < options.impulse_sweeps; ++sweep) {
+        const std::vector<Contact> contacts = resolver.detect(d);
+        if (sweep == 0)
+            report.collisions_first_sweep = static_cast<int>(contacts.size());
+        if (contacts.empty()) {
+            // Verified collision-free: done without impact zones.
+            for (size_t i = 0; i < n; ++i)
+                x_t1[i] = x_t0[i] + d[i];
+            return report;
+        }
+        for (const Contact& c : contacts)
+            report.impulses += apply_impulse(c, inv, d) ? 1 : 0;
+    }
+
+    // Phases 3 and 4, on shorter and shorter motions if needed.
+    double fraction = 1.0;
+    for (int attempt = 0; attempt <= options.max_step_shortenings; ++attempt) {
+        std::vector<Vec3> trial = d;
+        if (resolver.impact_zones(trial, report) || resolver.rigid_zones(trial, report)) {
+            for (size_t i = 0; i < n; ++i)
+                x_t1[i] = x_t0[i] + trial[i];
+            report.motion_fraction = fraction;
+            return report;
+        }
+        // Fallback: shorten the whole motion and try again from the requested one.
+        ++report.step_shortenings;
+        fraction *= 0.5;
+        for (size_t i = 0; i < n; ++i)
+            d[i] = fraction * requested[i];
+    }
+    // Nothing could be verified: do not move (always collision-free from a free state).
+    x_t1 = x_t0;
+    report.motion_fraction = 0.0;
+    report.collision_free = true;
+    return report;
+}
+
+bool motion_is_collision_free(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
+                              const std::vector<Vec3>& x_t1) {
+    CollisionOptions o;
+    const Resolver resolver(mesh, x_t0, o, std::vector<double>(x_t0.size(), 1.0));
+    std::vector<Vec3> d(x_t0.size());
+    if (x_t1.size() != x_t0.size())
+        throw std::invalid_argument("motion_is_collision_free: position counts differ");
+    for (size_t i = 0; i < d.size(); ++i)
+        d[i] = x_t1[i] - x_t0[i];
+    return resolver.detect(d).empty();
+}
+
+}  // namespace meniscus::tracker

@@ -1,0 +1,60 @@
+#include "tracker/surface_tracker.h"
+
+#include "tracker/mesh_intersections.h"
+#include "tracker/mesh_measures.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace meniscus::tracker {
+
+void TrackerOptions::validate() const {
+    if (!(proximity_fraction > 0.0) || !std::isfinite(proximity_fraction))
+        throw std::invalid_argument("proximity_fraction: expected a number > 0");
+    CollisionOptions c = collision;
+    c.proximity_epsilon = 1.0;  // overwritten from proximity_fraction; validate the rest
+    try {
+        c.validate();
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("collision/") + e.what());
+    }
+}
+
+SurfaceTracker::SurfaceTracker(SurfaceMesh mesh, const TrackerOptions& options)
+    : m_mesh(std::move(mesh)), m_options(options) {
+    m_options.validate();
+    m_xi = edge_length_stats(m_mesh).mean;
+    if (!(m_xi > 0.0))
+        throw std::invalid_argument("SurfaceTracker: the mesh has no edges");
+    m_options.collision.proximity_epsilon = m_options.proximity_fraction * m_xi;
+}
+
+IntegrateResult SurfaceTracker::integrate(const std::vector<Vec3>& velocities, double dt) {
+    const auto start = std::chrono::steady_clock::now();
+    if (velocities.size() != static_cast<size_t>(m_mesh.num_vertices()))
+        throw std::invalid_argument(
+            "SurfaceTracker::integrate: " + std::to_string(velocities.size()) + " velocities for " +
+            std::to_string(m_mesh.num_vertices()) + " vertex slots");
+    if (!(dt > 0.0) || !std::isfinite(dt))
+        throw std::invalid_argument("SurfaceTracker::integrate: dt must be a finite number > 0");
+    const std::vector<Vec3>& x0 = m_mesh.positions();
+    std::vector<Vec3> x1(x0.size());
+    for (size_t i = 0; i < x0.size(); ++i)
+        x1[i] = m_mesh.vertex_alive(static_cast<int>(i)) ? Vec3(x0[i] + dt * velocities[i]) : x0[i];
+
+    IntegrateResult result;
+    if (m_options.collision_safety)
+        result.collisions = resolve_collisions(m_mesh, x0, x1, dt, m_options.collision);
+    result.time_advanced = dt * result.collisions.motion_fraction;
+    m_mesh.set_positions(x1);
+    if (m_options.verify_intersection_free)
+        result.intersecting_pairs =
+            static_cast<int>(find_self_intersections(m_mesh).triangle_pairs.size());
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+}  // namespace meniscus::tracker

@@ -1,0 +1,59 @@
+#pragma once
+/// \file SurfaceTracker: the thin orchestrator of the paper's algorithm (§3.3) over the free
+/// functions of the tracker — mesh improvement, topology changes, and collision-safe
+/// integration. It knows nothing about grids or fluids: callers give per-vertex velocities.
+
+#include "tracker/collision_resolution.h"
+#include "tracker/mesh.h"
+
+#include <vector>
+
+namespace meniscus::tracker {
+
+/// Options of the tracker. Lengths are fractions of ξ, the mean edge length of the mesh the
+/// tracker was created with, so a scene scales without retuning.
+struct TrackerOptions {
+    bool collision_safety = true;  ///< §3.3 switch: enforce intersection-free motion
+    /// ε_p as a fraction of ξ (repulsion distance of collision resolution).
+    double proximity_fraction = 1e-3;
+    /// Run the exact static self-intersection test after every integrate() and report it.
+    bool verify_intersection_free = false;
+    /// Collision resolution tuning; its proximity_epsilon is overwritten from
+    /// proximity_fraction · ξ.
+    CollisionOptions collision;
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// What one integrate() call did.
+struct IntegrateResult {
+    CollisionReport collisions;
+    double time_advanced = 0.0;   ///< seconds of motion applied (dt × collisions.motion_fraction)
+    int intersecting_pairs = -1;  ///< exact check result when verification is on, else −1
+    double seconds = 0.0;         ///< wall time spent
+};
+
+/// Owns the surface mesh and moves it safely.
+class SurfaceTracker {
+public:
+    /// Takes the initial mesh (must be non-empty; intersection-free for the guarantee) and
+    /// options (validated; throws std::invalid_argument naming the field).
+    SurfaceTracker(SurfaceMesh mesh, const TrackerOptions& options);
+
+    SurfaceMesh& mesh() { return m_mesh; }
+    const SurfaceMesh& mesh() const { return m_mesh; }
+    const TrackerOptions& options() const { return m_options; }
+    /// ξ: mean edge length of the initial mesh (metres).
+    double characteristic_length() const { return m_xi; }
+
+    /// Moves every live vertex by velocities[vi] · dt (velocities sized mesh().num_vertices()),
+    /// changed as little as needed to keep the mesh intersection-free when collision safety is
+    /// on. Throws std::invalid_argument on size mismatch or dt ≤ 0.
+    IntegrateResult integrate(const std::vector<Vec3>& velocities, double dt);
+
+private:
+    SurfaceMesh m_mesh;
+    TrackerOptions m_options;
+    double m_xi = 0.0;
+};
+
+}  // namespace meniscus::tracker
