@@ -501,6 +501,24 @@ TEST(FaceOffsetting, ConcaveCreaseRisesToThePlanesIntersection) {
     EXPECT_LT((down_sharp.displacements[static_cast<size_t>(crease)] + expected).norm(), 1e-14);
 }
 
+TEST(FaceOffsetting, NearFoldOffsetIsCapped) {
+    // A valley with slope 10 (normals 2·84.3° apart): the planes meet 10.05 h above the crease;
+    // the cap (default 4) holds the crease vertex to 4 h along the same direction.
+    const double h = 0.01;
+    const SurfaceMesh mesh = valley_mesh(10.0, 4);
+    const size_t crease = 2 * 4 + 1 + 4;
+    const FaceOffset capped = face_offset_displacements(mesh, 1.0, h);
+    FaceOffsettingOptions loose;
+    loose.max_offset_ratio = 20.0;
+    const FaceOffset uncapped = face_offset_displacements(mesh, 1.0, h, loose);
+    EXPECT_EQ(capped.capped[crease], 1);
+    EXPECT_EQ(uncapped.capped[crease], 0);
+    EXPECT_NEAR(uncapped.displacements[crease].z(), h * std::sqrt(101.0), 1e-12);
+    EXPECT_LT((capped.displacements[crease] - Vec3(0, 0, 4.0 * h)).norm(), 1e-12);
+    loose.max_offset_ratio = 0.5;
+    EXPECT_THROW(face_offset_displacements(mesh, 1.0, h, loose), std::invalid_argument);
+}
+
 TEST(FaceOffsetting, InversionLimitIsExactForOneTriangle) {
     const SurfaceMesh mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
     // Vertex 2 moves straight down through the opposite edge: area ∝ (1 − 2τ).

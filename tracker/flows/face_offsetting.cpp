@@ -14,9 +14,8 @@ namespace {
 
 /// |(b − a) × (c − a)| below this times the squared longest edge counts as degenerate.
 constexpr double DEGENERATE_AREA_RATIO = 1e-14;
-/// |Σ wᵢ (cᵢ − x)·m| below this times Σ wᵢ |cᵢ − x| counts as flat (neither convex nor
-/// concave): the plane intersection is used.
-constexpr double FLAT_RATIO = 1e-9;
+/// Dihedral angles (radians) below this count as flat: neither convex nor concave.
+constexpr double FLAT_DIHEDRAL = 1e-9;
 /// Step reduction applied per retry in face_offset_step() when displacements are not linear in
 /// Δt (null-space smoothing on).
 constexpr double RETRY_REDUCTION = 0.5;
@@ -33,6 +32,43 @@ bool is_degenerate(const Vec3& area_vector, const Vec3& a, const Vec3& b, const 
 double corner_angle(const Vec3& p, const Vec3& q, const Vec3& r) {
     const Vec3 u = q - p, v = r - p;
     return std::atan2(u.cross(v).norm(), u.dot(v));
+}
+
+/// For each vertex slot, the signed dihedral angle (radians, in [−π, π]) of its incident edge
+/// with the largest |angle|: positive where the surface is convex there (the far vertex of one
+/// triangle lies behind the other's plane), negative where concave. Only edges with exactly two
+/// live, non-degenerate triangles count; 0 where there is none.
+std::vector<double> dominant_dihedral_angles(const SurfaceMesh& mesh) {
+    std::vector<double> dominant(static_cast<size_t>(mesh.num_vertices()), 0.0);
+    auto unit_normal = [&mesh](int ti, Vec3& n) {
+        const Triangle& t = mesh.triangle(ti);
+        const Vec3& a = mesh.position(t[0]);
+        const Vec3& b = mesh.position(t[1]);
+        const Vec3& c = mesh.position(t[2]);
+        const Vec3 area_vector = (b - a).cross(c - a);
+        if (is_degenerate(area_vector, a, b, c))
+            return false;
+        n = area_vector.normalized();
+        return true;
+    };
+    for (int ei = 0; ei < mesh.num_edges(); ++ei) {
+        if (!mesh.edge_alive(ei) || mesh.edge_triangles(ei).size() != 2)
+            continue;
+        const int t0 = mesh.edge_triangles(ei)[0], t1 = mesh.edge_triangles(ei)[1];
+        Vec3 n0, n1;
+        if (!unit_normal(t0, n0) || !unit_normal(t1, n1))
+            continue;
+        const Edge& e = mesh.edge(ei);
+        const Vec3 far1 = mesh.position(mesh.opposite_vertex(t1, ei)) - mesh.position(e[0]);
+        const double angle = std::atan2(n0.cross(n1).norm(), n0.dot(n1));
+        const double signed_angle = far1.dot(n0) <= 0.0 ? angle : -angle;
+        for (int vi : e) {
+            double& d = dominant[static_cast<size_t>(vi)];
+            if (std::abs(signed_angle) > std::abs(d))
+                d = signed_angle;
+        }
+    }
+    return dominant;
 }
 
 /// Smallest τ in (0, ∞) with c0 + c1 τ + c2 τ² = 0, given c0 > 0; +∞ if there is none.
@@ -65,6 +101,9 @@ void FaceOffsettingOptions::validate() const {
     if (!(primary_eigenvalue_ratio > 0.0 && primary_eigenvalue_ratio < 1.0))
         throw std::invalid_argument("primary_eigenvalue_ratio: expected a number in (0, 1), got " +
                                     std::to_string(primary_eigenvalue_ratio));
+    if (!(max_offset_ratio >= 1.0) || !std::isfinite(max_offset_ratio))
+        throw std::invalid_argument("max_offset_ratio: expected a finite number >= 1, got " +
+                                    std::to_string(max_offset_ratio));
     if (!(null_space_smoothing >= 0.0 && null_space_smoothing <= 1.0))
         throw std::invalid_argument("null_space_smoothing: expected a number in [0, 1], got " +
                                     std::to_string(null_space_smoothing));
@@ -99,10 +138,9 @@ FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
     std::vector<Vec3> centroid_sum(nv, Vec3::Zero());
     std::vector<double> area_sum(nv, 0.0);
     std::vector<Vec3> normal_sum(nv, Vec3::Zero());  // Σ wᵢ nᵢ
-    std::vector<Vec3> spread_sum(nv, Vec3::Zero());  // Σ wᵢ (cᵢ − x)
-    std::vector<double> spread_norm(nv, 0.0);        // Σ wᵢ |cᵢ − x|
     std::vector<double> offset_sum(nv, 0.0);         // Σ wᵢ hᵢ
     std::vector<double> weight_sum(nv, 0.0);         // Σ wᵢ
+    std::vector<double> max_offset(nv, 0.0);         // maxᵢ |hᵢ|
 
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
         if (!mesh.triangle_alive(ti))
@@ -128,10 +166,9 @@ FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
             centroid_sum[vi] += area * centroid;
             area_sum[vi] += area;
             normal_sum[vi] += w * n;
-            spread_sum[vi] += w * (centroid - p[k]);
-            spread_norm[vi] += w * (centroid - p[k]).norm();
             offset_sum[vi] += w * offset;
             weight_sum[vi] += w;
+            max_offset[vi] = std::max(max_offset[vi], std::abs(offset));
         }
     }
 
@@ -139,6 +176,9 @@ FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
     result.displacements.assign(nv, Vec3::Zero());
     result.primary_rank.assign(nv, 0);
     result.expanding.assign(nv, 0);
+    result.capped.assign(nv, 0);
+    // Signed dihedral angle of each vertex's sharpest incident edge (convex > 0).
+    const std::vector<double> dominant_dihedral = dominant_dihedral_angles(mesh);
     for (size_t vi = 0; vi < nv; ++vi) {
         if (!mesh.vertex_alive(static_cast<int>(vi)) || area_sum[vi] <= 0.0)
             continue;
@@ -164,12 +204,16 @@ FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
         if (options.expansion == ExpansionRule::huygens && normal_length > 0.0) {
             const Vec3 m = normal_sum[vi] / normal_length;
             const double mean_offset = offset_sum[vi] / weight_sum[vi];
-            const double convexity = spread_sum[vi].dot(m);  // < 0: one-ring behind the plane
-            if (std::abs(convexity) > FLAT_RATIO * spread_norm[vi] &&
-                mean_offset * convexity < 0.0) {
+            const double dihedral = dominant_dihedral[vi];
+            if (std::abs(dihedral) > FLAT_DIHEDRAL && mean_offset * dihedral > 0.0) {
                 d = mean_offset * m;
                 result.expanding[vi] = 1;
             }
+        }
+        const double cap = options.max_offset_ratio * max_offset[vi];
+        if (d.norm() > cap) {
+            d *= cap / d.norm();
+            result.capped[vi] = 1;
         }
         if (options.null_space_smoothing > 0.0) {
             const Vec3 to_centroid =

@@ -21,10 +21,11 @@
 /// converging under refinement. With `ExpansionRule::huygens` (default) such vertices instead
 /// move by the mean offset h̄ along the mean normal m = Σ wᵢ nᵢ / |Σ wᵢ nᵢ| (Huygens'
 /// principle: the exact fan point at distance h from the crease, for any m in the normal cone);
-/// remeshing then fills the widening fan. A vertex is expanding when h̄ · Σᵢ wᵢ (cᵢ − x)·m < 0,
-/// with cᵢ the incident triangles' centroids: the one-ring lies behind the tangent plane
-/// (convex) and the motion is outward, or in front (concave) and inward. On smooth patches both
-/// rules agree to O(h θ²).
+/// remeshing then fills the widening fan. The decision follows the vertex's sharpest incident
+/// edge (largest dihedral angle): the vertex is expanding when that edge is convex and the
+/// motion outward (h̄ > 0), or concave and inward. Deciding by the sharpest edge rather than by
+/// the mean curvature keeps a concave crease on a saddle (the neck right after two spheres
+/// merge, convex around the neck) a shock. On smooth patches both rules agree to O(h θ²).
 ///
 /// Weights wᵢ: triangle areas (default) or the triangle's interior angle at the vertex.
 ///
@@ -61,6 +62,12 @@ struct FaceOffsettingOptions {
     /// space still, so displacements are exactly linear in Δt and the tracker's own null-space
     /// smoothing improves the mesh between steps.
     double null_space_smoothing = 0.0;
+    /// Cap on the offset part of a displacement: |d| ≤ max_offset_ratio · maxᵢ |hᵢ| over the
+    /// incident triangles (≥ 1). Two planes whose normals are 2θ apart intersect at h / cos θ,
+    /// so the default 4 binds only at creases sharper than 2·75.5° — folds right after a merge
+    /// and low-valence vertices with scattered normals, where the least-squares intersection
+    /// would otherwise throw the vertex many offsets away.
+    double max_offset_ratio = 4.0;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
 
@@ -73,6 +80,8 @@ struct FaceOffset {
     std::vector<int> primary_rank;
     /// Per vertex slot: 1 if the vertex was treated as an expansion (Huygens rule), else 0.
     std::vector<int> expanding;
+    /// Per vertex slot: 1 if max_offset_ratio capped the offset, else 0.
+    std::vector<int> capped;
 };
 
 /// Face-offsetting displacements over one step of length `dt` (s) with per-triangle normal
@@ -131,7 +140,10 @@ constexpr int MAX_STEP_ATTEMPTS = 16;
 
 /// Remeshing guard for face-offsetting runs (paper §4.1: "we reject any edge collapse or edge
 /// flip operation that results in a triangle with a normal that is too different from the
-/// original triangle normals").
+/// original triangle normals"). improve_mesh() applies its own per-triangle form of this test
+/// through RemeshOptions::max_normal_change_degrees (remesh_options.h, default 60°);
+/// face-offsetting runs should lower that to `max_angle_degrees` here. These functions serve
+/// callers that assemble an operation's before/after triangles themselves.
 struct NormalTurnLimit {
     /// Largest allowed angle (degrees, in (0, 180)) between a new triangle's normal and the
     /// reference normal of the triangles it replaces.
