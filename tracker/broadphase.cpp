@@ -22,26 +22,6 @@ bool overlaps(const Box3d& a, const Box3d& b) {
     return (a.min().array() <= b.max().array()).all() && (b.min().array() <= a.max().array()).all();
 }
 
-/// Cell size from the mean box extent of the elements (never below a tiny fraction of the
-/// largest extent, so degenerate meshes still hash).
-double pick_cell_size(const std::vector<Box3d>& boxes) {
-    double sum = 0.0, largest = 0.0;
-    int n = 0;
-    for (const Box3d& b : boxes) {
-        if (b.isEmpty())
-            continue;
-        const double e = b.sizes().maxCoeff();
-        sum += e;
-        largest = std::max(largest, e);
-        ++n;
-    }
-    if (n == 0)
-        return 1.0;
-    const double mean = sum / n;
-    const double cell = std::max(mean, largest * 1e-6);
-    return cell > 0.0 ? cell : 1.0;
-}
-
 template <typename Pair, typename Emit>
 std::vector<Pair> collect_parallel(size_t count, Emit&& emit) {
     tbb::enumerable_thread_specific<std::vector<Pair>> local;
@@ -230,42 +210,170 @@ void SpatialHash::clear() {
     m_present.clear();
 }
 
+// ---- LooseGrid ----------------------------------------------------------------------------
+
+namespace {
+
+/// Loose-grid cell size as a multiple of the mean box extent: elements up to one cell wide sit
+/// in one cell; bigger ones go to the oversized list.
+constexpr double LOOSE_CELL_FACTOR = 2.0;
+
+std::uint64_t mix(std::int64_t key) {
+    std::uint64_t x = static_cast<std::uint64_t>(key);
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    return x;
+}
+
+}  // namespace
+
+std::int64_t LooseGrid::cell_key(const Eigen::Array3i& c) const {
+    // 21 bits per axis (offset into the non-negative range); distinct cells may alias only when
+    // the grid is more than two million cells wide, which merges lists (still a superset).
+    constexpr std::int64_t MASK = (1 << 21) - 1, OFFSET = 1 << 20;
+    return ((c.x() + OFFSET) & MASK) | (((c.y() + OFFSET) & MASK) << 21) |
+           (((c.z() + OFFSET) & MASK) << 42);
+}
+
+LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
+    double sum = 0.0;
+    int n = 0;
+    for (const Box3d& b : boxes) {
+        if (b.isEmpty())
+            continue;
+        sum += b.sizes().maxCoeff();
+        ++n;
+    }
+    m_cell = n > 0 && sum > 0.0 ? LOOSE_CELL_FACTOR * sum / n : 1.0;
+    std::vector<std::pair<std::int64_t, int>> keyed;
+    keyed.reserve(static_cast<size_t>(n));
+    const double limit = (1 << 20) - 2;
+    for (size_t i = 0; i < boxes.size(); ++i) {
+        const Box3d& b = boxes[i];
+        if (b.isEmpty())
+            continue;
+        const Eigen::Array3d lo = (b.min().array() / m_cell).floor();
+        if (b.sizes().maxCoeff() > m_cell || (lo.abs() > limit).any() || !lo.allFinite()) {
+            m_oversized.push_back(static_cast<int>(i));
+            continue;
+        }
+        keyed.emplace_back(cell_key(lo.cast<int>()), static_cast<int>(i));
+    }
+    std::sort(keyed.begin(), keyed.end());
+    size_t unique = 0;
+    for (size_t i = 0; i < keyed.size(); ++i)
+        if (i == 0 || keyed[i].first != keyed[i - 1].first)
+            ++unique;
+    size_t slots = 16;
+    while (slots < 2 * unique)
+        slots *= 2;
+    m_slot_key.assign(slots, -1);
+    m_slot_range.assign(slots, {0, 0});
+    m_ids.resize(keyed.size());
+    for (size_t i = 0; i < keyed.size();) {
+        size_t j = i;
+        while (j < keyed.size() && keyed[j].first == keyed[i].first) {
+            m_ids[j] = keyed[j].second;
+            ++j;
+        }
+        size_t slot = mix(keyed[i].first) & (slots - 1);
+        while (m_slot_key[slot] != -1)
+            slot = (slot + 1) & (slots - 1);
+        m_slot_key[slot] = keyed[i].first;
+        m_slot_range[slot] = {static_cast<int>(i), static_cast<int>(j)};
+        i = j;
+    }
+}
+
+void LooseGrid::query(const Box3d& box, std::vector<int>& out) const {
+    out.clear();
+    const Eigen::Array3d lo_d = ((box.min().array() - m_cell) / m_cell).floor();
+    const Eigen::Array3d hi_d = (box.max().array() / m_cell).floor();
+    const double limit = (1 << 20) - 2;
+    const double cells = ((hi_d - lo_d) + 1.0).prod();
+    if (!(cells <= static_cast<double>(MAX_CELLS_PER_BOX)) || (lo_d.abs() > limit).any() ||
+        (hi_d.abs() > limit).any()) {
+        for (size_t i = 0; i < m_boxes.size(); ++i)
+            if (!m_boxes[i].isEmpty() && overlaps(m_boxes[i], box))
+                out.push_back(static_cast<int>(i));
+        return;
+    }
+    const Eigen::Array3i lo = lo_d.cast<int>(), hi = hi_d.cast<int>();
+    const size_t mask = m_slot_key.size() - 1;
+    for (int z = lo.z(); z <= hi.z(); ++z)
+        for (int y = lo.y(); y <= hi.y(); ++y)
+            for (int x = lo.x(); x <= hi.x(); ++x) {
+                const std::int64_t key = cell_key(Eigen::Array3i(x, y, z));
+                size_t slot = mix(key) & mask;
+                while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
+                    slot = (slot + 1) & mask;
+                if (m_slot_key[slot] == -1)
+                    continue;
+                const auto [begin, end] = m_slot_range[slot];
+                for (int k = begin; k < end; ++k) {
+                    const int id = m_ids[static_cast<size_t>(k)];
+                    if (overlaps(m_boxes[static_cast<size_t>(id)], box))
+                        out.push_back(id);
+                }
+            }
+    for (int id : m_oversized)
+        if (overlaps(m_boxes[static_cast<size_t>(id)], box))
+            out.push_back(id);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
 // ---- BroadPhase ---------------------------------------------------------------------------
+
+namespace {
+
+template <typename MakeBox>
+std::vector<Box3d> boxes_of(int count, MakeBox&& make) {
+    std::vector<Box3d> boxes(static_cast<size_t>(count));  // default: empty
+    tbb::parallel_for(tbb::blocked_range<int>(0, count, 4096),
+                      [&](const tbb::blocked_range<int>& r) {
+                          for (int i = r.begin(); i < r.end(); ++i)
+                              make(i, boxes[static_cast<size_t>(i)]);
+                      });
+    return boxes;
+}
+
+}  // namespace
 
 BroadPhase::BroadPhase(const SurfaceMesh& mesh, double padding)
     : BroadPhase(mesh, mesh.positions(), mesh.positions(), padding) {}
 
 BroadPhase::BroadPhase(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
                        const std::vector<Vec3>& x_t1, double padding)
-    : m_mesh(mesh) {
-    check_sizes(mesh, x_t0, x_t1, padding);
-    std::vector<Box3d> tri_boxes(static_cast<size_t>(mesh.num_triangles()));
-    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
-        if (mesh.triangle_alive(ti))
-            tri_boxes[static_cast<size_t>(ti)] =
-                triangle_box(x_t0, x_t1, mesh.triangle(ti), padding);
-    const double cell = pick_cell_size(tri_boxes);
-    m_vertices = SpatialHash(cell);
-    m_edges = SpatialHash(cell);
-    m_triangles = SpatialHash(cell);
-    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
-        if (mesh.triangle_alive(ti))
-            m_triangles.insert(ti, tri_boxes[static_cast<size_t>(ti)]);
-    for (int ei = 0; ei < mesh.num_edges(); ++ei)
-        if (mesh.edge_alive(ei))
-            m_edges.insert(ei, edge_box(x_t0, x_t1, mesh.edge(ei), padding));
-    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
-        if (mesh.vertex_alive(vi) && !mesh.vertex_triangles(vi).empty())
-            m_vertices.insert(vi, vertex_box(x_t0, x_t1, vi, padding));
-}
+    : m_mesh(mesh),
+      m_vertex_boxes((check_sizes(mesh, x_t0, x_t1, padding),
+                      boxes_of(mesh.num_vertices(),
+                               [&](int vi, Box3d& b) {
+                                   if (mesh.vertex_alive(vi) && !mesh.vertex_triangles(vi).empty())
+                                       b = vertex_box(x_t0, x_t1, vi, padding);
+                               }))),
+      m_edge_boxes(boxes_of(mesh.num_edges(),
+                            [&](int ei, Box3d& b) {
+                                if (mesh.edge_alive(ei))
+                                    b = edge_box(x_t0, x_t1, mesh.edge(ei), padding);
+                            })),
+      m_triangle_boxes(boxes_of(mesh.num_triangles(),
+                                [&](int ti, Box3d& b) {
+                                    if (mesh.triangle_alive(ti))
+                                        b = triangle_box(x_t0, x_t1, mesh.triangle(ti), padding);
+                                })),
+      m_edges(m_edge_boxes),
+      m_triangles(m_triangle_boxes) {}
 
 std::vector<VertexTrianglePair> BroadPhase::vertex_triangle_pairs() const {
     return collect_parallel<VertexTrianglePair>(
-        static_cast<size_t>(m_mesh.num_vertices()),
+        m_vertex_boxes.size(),
         [&](int vi, std::vector<int>& scratch, std::vector<VertexTrianglePair>& out) {
-            if (!m_vertices.contains(vi))
+            const Box3d& vb = m_vertex_boxes[static_cast<size_t>(vi)];
+            if (vb.isEmpty())
                 return;
-            m_triangles.query(m_vertices.box(vi), scratch);
+            m_triangles.query(vb, scratch);
             for (int ti : scratch) {
                 const Triangle& t = m_mesh.triangle(ti);
                 if (t[0] != vi && t[1] != vi && t[2] != vi)
@@ -276,7 +384,7 @@ std::vector<VertexTrianglePair> BroadPhase::vertex_triangle_pairs() const {
 
 std::vector<EdgeEdgePair> BroadPhase::edge_edge_pairs() const {
     return collect_parallel<EdgeEdgePair>(
-        static_cast<size_t>(m_mesh.num_edges()),
+        m_edge_boxes.size(),
         [&](int ei, std::vector<int>& scratch, std::vector<EdgeEdgePair>& out) {
             if (!m_edges.contains(ei))
                 return;
@@ -289,7 +397,7 @@ std::vector<EdgeEdgePair> BroadPhase::edge_edge_pairs() const {
 
 std::vector<TrianglePair> BroadPhase::triangle_pairs() const {
     return collect_parallel<TrianglePair>(
-        static_cast<size_t>(m_mesh.num_triangles()),
+        m_triangle_boxes.size(),
         [&](int ti, std::vector<int>& scratch, std::vector<TrianglePair>& out) {
             if (!m_triangles.contains(ti))
                 return;

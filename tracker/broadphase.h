@@ -87,6 +87,32 @@ struct TrianglePair {
     }
 };
 
+/// Static loose grid for bulk queries: every element sits in exactly one cell (the one holding
+/// its box's minimum corner), stored contiguously (CSR) and found through a flat hash of cell
+/// keys; elements larger than a cell go to a list checked by every query. A query box looks at
+/// the cells its box reaches extended by one cell towards −∞, which covers every element whose
+/// box can overlap it. Built in O(n log n) by one sort; queries are read-only and thread-safe.
+class LooseGrid {
+public:
+    /// Builds over `boxes` (empty boxes are skipped); ids are the indices into `boxes`.
+    explicit LooseGrid(const std::vector<Box3d>& boxes);  // keeps a reference to `boxes`
+    LooseGrid(const LooseGrid&) = delete;
+    LooseGrid& operator=(const LooseGrid&) = delete;
+    /// Replaces `out` with the sorted ids whose boxes overlap `box` (closed boxes).
+    void query(const Box3d& box, std::vector<int>& out) const;
+    const Box3d& box(int id) const { return m_boxes[static_cast<size_t>(id)]; }
+    bool contains(int id) const { return !m_boxes[static_cast<size_t>(id)].isEmpty(); }
+
+private:
+    std::int64_t cell_key(const Eigen::Array3i& c) const;
+    const std::vector<Box3d>& m_boxes;
+    double m_cell = 1.0;
+    std::vector<int> m_ids;                         // ids grouped by cell
+    std::vector<std::int64_t> m_slot_key;           // flat hash: key per slot (−1 = empty)
+    std::vector<std::pair<int, int>> m_slot_range;  // [begin, end) into m_ids per slot
+    std::vector<int> m_oversized;
+};
+
 /// Candidate pairs of a mesh moving linearly from x_t0 to x_t1.
 class BroadPhase {
 public:
@@ -97,6 +123,9 @@ public:
                const std::vector<Vec3>& x_t1, double padding);
     /// Static variant: x_t0 = x_t1 = the mesh's positions.
     BroadPhase(const SurfaceMesh& mesh, double padding);
+    // The grids refer to the box arrays of this object: not copyable or movable.
+    BroadPhase(const BroadPhase&) = delete;
+    BroadPhase& operator=(const BroadPhase&) = delete;
 
     /// Vertex–triangle pairs with overlapping boxes, the vertex not in the triangle; sorted.
     std::vector<VertexTrianglePair> vertex_triangle_pairs() const;
@@ -105,13 +134,10 @@ public:
     /// Triangle pairs with overlapping boxes (including neighbours); sorted.
     std::vector<TrianglePair> triangle_pairs() const;
 
-    const SpatialHash& vertices() const { return m_vertices; }
-    const SpatialHash& edges() const { return m_edges; }
-    const SpatialHash& triangles() const { return m_triangles; }
-
 private:
     const SurfaceMesh& m_mesh;
-    SpatialHash m_vertices, m_edges, m_triangles;
+    std::vector<Box3d> m_vertex_boxes, m_edge_boxes, m_triangle_boxes;
+    LooseGrid m_edges, m_triangles;
 };
 
 /// Box of points moving linearly from p_t0[i] to p_t1[i], padded by `padding`.
