@@ -1,0 +1,220 @@
+#include "coupling/surface_tension.h"
+
+#include "tracker/distance.h"
+#include "tracker/flows/mean_curvature.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace meniscus::coupling {
+
+namespace {
+
+using tracker::SurfaceMesh;
+using tracker::Vec3;
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// +1 if the liquid lies behind the triangles of vertex vi (their normals point out of the
+/// liquid), −1 if it lies in front; decided by the first incident live triangle that has the
+/// liquid on exactly one side (+1 when none has).
+double liquid_orientation(const SurfaceMesh& mesh, int vi, int liquid_region) {
+    for (int ti : mesh.vertex_triangles(vi)) {
+        if (!mesh.triangle_alive(ti))
+            continue;
+        const tracker::LabelPair& labels = mesh.labels(ti);
+        const bool inside = labels.inside == liquid_region;
+        const bool outside = labels.outside == liquid_region;
+        if (inside != outside)
+            return inside ? 1.0 : -1.0;
+    }
+    return 1.0;
+}
+
+/// κ at the point of live triangle ti closest to x, interpolated barycentrically; `distance`
+/// receives |x − that point|.
+double curvature_at_closest_point(const SurfaceMesh& mesh, const std::vector<double>& kappa, int ti,
+                                  const Vec3& x, double& distance) {
+    const tracker::Triangle& t = mesh.triangle(ti);
+    const tracker::PointTriangleProximity proximity = tracker::point_triangle_proximity(
+        x, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+    distance = proximity.distance;
+    return proximity.barycentric[0] * kappa[static_cast<size_t>(t[0])] +
+           proximity.barycentric[1] * kappa[static_cast<size_t>(t[1])] +
+           proximity.barycentric[2] * kappa[static_cast<size_t>(t[2])];
+}
+
+/// Per-face tallies of one velocity component's faces, reduced after the parallel loop.
+struct AxisTally {
+    long long crossed = 0;
+    long long without_triangle = 0;
+    double min_kappa = std::numeric_limits<double>::infinity();
+    double max_kappa = -std::numeric_limits<double>::infinity();
+};
+
+}  // namespace
+
+void SurfaceTensionOptions::validate() const {
+    if (smoothing_passes < 0)
+        throw std::invalid_argument("smoothing_passes: expected an integer >= 0, got " +
+                                    std::to_string(smoothing_passes));
+}
+
+std::vector<double> liquid_vertex_curvatures(const tracker::SurfaceMesh& mesh, int liquid_region,
+                                             int smoothing_passes) {
+    if (smoothing_passes < 0)
+        throw std::invalid_argument("smoothing_passes: expected an integer >= 0");
+    std::vector<double> kappa = tracker::mean_curvatures(mesh);
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        if (mesh.vertex_alive(vi))
+            kappa[static_cast<size_t>(vi)] *= liquid_orientation(mesh, vi, liquid_region);
+    if (smoothing_passes == 0)
+        return kappa;
+
+    const std::vector<double> area = tracker::mixed_voronoi_areas(mesh);
+    std::vector<double> smoothed(kappa.size(), 0.0);
+    for (int pass = 0; pass < smoothing_passes; ++pass) {
+        tbb::parallel_for(0, mesh.num_vertices(), [&](int vi) {
+            const size_t v = static_cast<size_t>(vi);
+            if (!mesh.vertex_alive(vi) || mesh.vertex_edges(vi).empty() ||
+                mesh.is_boundary_vertex(vi)) {
+                smoothed[v] = kappa[v];
+                return;
+            }
+            double weighted = area[v] * kappa[v];
+            double total = area[v];
+            for (int ei : mesh.vertex_edges(vi)) {
+                const size_t w = static_cast<size_t>(mesh.other_vertex(ei, vi));
+                weighted += area[w] * kappa[w];
+                total += area[w];
+            }
+            smoothed[v] = total > 0.0 ? weighted / total : kappa[v];
+        });
+        kappa.swap(smoothed);
+    }
+    return kappa;
+}
+
+SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
+                                     const RasterizeResult& raster,
+                                     const SurfaceTensionOptions& options,
+                                     fluid::InterfaceInput& interface) {
+    options.validate();
+    const int nx = grid.nx();
+    const int ny = grid.ny();
+    const int nz = grid.nz();
+    const auto sized = [&](const auto& field) {
+        return field.ni() == nx && field.nj() == ny && field.nk() == nz;
+    };
+    if (!sized(raster.phi) || !sized(raster.closest_triangle))
+        throw std::invalid_argument("raster: phi and closest_triangle must be nx x ny x nz");
+
+    SurfaceTensionResult result;
+    const Clock::time_point vertex_start = Clock::now();
+    const std::vector<double> kappa =
+        liquid_vertex_curvatures(mesh, raster.liquid_region, options.smoothing_passes);
+    result.vertex_seconds = seconds_since(vertex_start);
+
+    const Clock::time_point face_start = Clock::now();
+    interface.kappa_u.resize(nx + 1, ny, nz, 0.0);
+    interface.kappa_v.resize(nx, ny + 1, nz, 0.0);
+    interface.kappa_w.resize(nx, ny, nz + 1, 0.0);
+    std::array<AxisTally, 3> tallies;
+    for (int axis = 0; axis < 3; ++axis) {
+        fluid::Array3<double>& face_kappa = interface.kappa(axis);
+        const int di = axis == 0 ? 1 : 0;
+        const int dj = axis == 1 ? 1 : 0;
+        const int dk = axis == 2 ? 1 : 0;
+        // Only interior faces have two cells; slabs in k run in parallel.
+        tallies[static_cast<size_t>(axis)] = tbb::parallel_reduce(
+            tbb::blocked_range<int>(dk, face_kappa.nk() - dk), AxisTally(),
+            [&](const tbb::blocked_range<int>& range, AxisTally tally) {
+                for (int k = range.begin(); k != range.end(); ++k)
+                    for (int j = dj; j < face_kappa.nj() - dj; ++j)
+                        for (int i = di; i < face_kappa.ni() - di; ++i) {
+                            const double phi_lo = raster.phi(i - di, j - dj, k - dk);
+                            const double phi_hi = raster.phi(i, j, k);
+                            if (fluid::is_liquid(phi_lo) == fluid::is_liquid(phi_hi))
+                                continue;
+                            ++tally.crossed;
+                            const Vec3 x_lo = grid.cell_centre(i - di, j - dj, k - dk);
+                            const Vec3 x_hi = grid.cell_centre(i, j, k);
+                            const double theta = phi_lo / (phi_lo - phi_hi);
+                            const Vec3 x = x_lo + theta * (x_hi - x_lo);
+                            double best = std::numeric_limits<double>::infinity();
+                            double value = 0.0;
+                            for (int ti : {raster.closest_triangle(i - di, j - dj, k - dk),
+                                           raster.closest_triangle(i, j, k)}) {
+                                if (ti == tracker::INVALID_INDEX)
+                                    continue;
+                                double distance = 0.0;
+                                const double candidate =
+                                    curvature_at_closest_point(mesh, kappa, ti, x, distance);
+                                if (distance < best) {
+                                    best = distance;
+                                    value = candidate;
+                                }
+                            }
+                            if (best == std::numeric_limits<double>::infinity()) {
+                                ++tally.without_triangle;
+                                continue;
+                            }
+                            face_kappa(i, j, k) = value;
+                            tally.min_kappa = std::min(tally.min_kappa, value);
+                            tally.max_kappa = std::max(tally.max_kappa, value);
+                        }
+                return tally;
+            },
+            [](AxisTally a, const AxisTally& b) {
+                a.crossed += b.crossed;
+                a.without_triangle += b.without_triangle;
+                a.min_kappa = std::min(a.min_kappa, b.min_kappa);
+                a.max_kappa = std::max(a.max_kappa, b.max_kappa);
+                return a;
+            });
+    }
+    double min_kappa = std::numeric_limits<double>::infinity();
+    double max_kappa = -std::numeric_limits<double>::infinity();
+    for (const AxisTally& tally : tallies) {
+        result.crossed_faces += tally.crossed;
+        result.faces_without_triangle += tally.without_triangle;
+        min_kappa = std::min(min_kappa, tally.min_kappa);
+        max_kappa = std::max(max_kappa, tally.max_kappa);
+    }
+    if (min_kappa <= max_kappa) {
+        result.min_kappa = min_kappa;
+        result.max_kappa = max_kappa;
+    }
+    result.face_seconds = seconds_since(face_start);
+    return result;
+}
+
+fluid::InterfaceInput interface_from_mesh(const tracker::SurfaceMesh& mesh,
+                                          const fluid::MacGrid& grid,
+                                          const RasterizeOptions& raster_options,
+                                          const SurfaceTensionOptions& tension_options,
+                                          SurfaceTensionResult* tension_result) {
+    tension_options.validate();
+    RasterizeResult raster = rasterize_mesh(mesh, grid, raster_options);
+    fluid::InterfaceInput interface;
+    const SurfaceTensionResult tension =
+        face_curvatures(mesh, grid, raster, tension_options, interface);
+    interface.phi = std::move(raster.phi);
+    if (tension_result != nullptr)
+        *tension_result = tension;
+    return interface;
+}
+
+}  // namespace meniscus::coupling

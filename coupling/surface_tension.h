@@ -1,0 +1,70 @@
+#pragma once
+/// \file Mesh → grid, second half: the mean curvature κ of the interface mesh at the faces the
+/// level set crosses, as the fluid's ghost-fluid pressure jump p_liquid − p_gas = σκ needs it.
+///
+/// κ comes from the mesh, not from derivatives of φ: the cotangent mean curvature at vertices
+/// (tracker/flows/mean_curvature.h, Meyer et al. 2003), optionally smoothed by area-weighted
+/// one-ring averaging, then interpolated barycentrically at the point of the closest triangle
+/// nearest to each crossing x = x_lo + θ (x_hi − x_lo), θ = φ_lo / (φ_lo − φ_hi), between the
+/// centres of the two cells next to the face.
+///
+/// Sign: the fluid's convention — κ > 0 for a convex liquid blob (a drop), < 0 around a gas
+/// bubble. The mesh's per-vertex κ is positive where the surface is convex as seen from the side
+/// its normals point into; a vertex whose triangles have the liquid behind them (labels.inside =
+/// liquid region) keeps that sign, one with the liquid in front (labels.outside = liquid) flips
+/// it.
+
+#include "coupling/rasterize.h"
+#include "fluid/interface_input.h"
+#include "fluid/mac_grid.h"
+#include "tracker/mesh.h"
+
+#include <vector>
+
+namespace meniscus::coupling {
+
+/// Options of the curvature at face crossings.
+struct SurfaceTensionOptions {
+    /// Area-weighted one-ring averaging passes over the vertex curvature before it is
+    /// interpolated (0 = raw cotangent curvature). Each pass widens the averaging stencil by one
+    /// ring of edges; use about (dx / mean edge length)² passes to smooth to the grid scale.
+    int smoothing_passes = 0;
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// What face_curvatures() did.
+struct SurfaceTensionResult {
+    long long crossed_faces = 0;  ///< interior faces whose two cells have φ of opposite sign
+    /// Crossed faces neither of whose cells had a closest triangle (κ left 0; a band that is
+    /// too thin or a rasterization that does not belong to this mesh).
+    long long faces_without_triangle = 0;
+    double min_kappa = 0.0;       ///< over the crossed faces, 1/m (0 when none)
+    double max_kappa = 0.0;       ///< over the crossed faces, 1/m (0 when none)
+    double vertex_seconds = 0.0;  ///< vertex curvature and smoothing, wall clock
+    double face_seconds = 0.0;    ///< interpolation to the faces, wall clock
+};
+
+/// Signed mean curvature κ (1/m, sum of principal curvatures) per vertex in the fluid's sign
+/// convention (see the file comment), smoothed by `smoothing_passes` area-weighted one-ring
+/// averages. Sized num_vertices(); zero for dead, isolated and boundary vertices.
+std::vector<double> liquid_vertex_curvatures(const tracker::SurfaceMesh& mesh, int liquid_region,
+                                             int smoothing_passes);
+
+/// Fills interface.kappa_u, kappa_v and kappa_w (resized for `grid`, zero on faces that are
+/// not crossed) from the mesh curvature, using φ and the closest triangles of `raster` (which
+/// must come from rasterize_mesh() of the same mesh on the same grid). interface.phi is not
+/// touched. Throws std::invalid_argument on invalid options or a raster of another size.
+SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
+                                     const RasterizeResult& raster,
+                                     const SurfaceTensionOptions& options,
+                                     fluid::InterfaceInput& interface);
+
+/// Convenience for one fluid step: rasterize `mesh` (φ) and fill κ at the crossed faces.
+/// Throws as rasterize_mesh() and face_curvatures().
+fluid::InterfaceInput interface_from_mesh(const tracker::SurfaceMesh& mesh,
+                                          const fluid::MacGrid& grid,
+                                          const RasterizeOptions& raster_options = {},
+                                          const SurfaceTensionOptions& tension_options = {},
+                                          SurfaceTensionResult* tension_result = nullptr);
+
+}  // namespace meniscus::coupling
