@@ -61,6 +61,8 @@ void TopologyOptions::validate() const {
             "must be finite and > 0");
     require(max_zipper_alignments >= 1 && max_zipper_alignments <= 4,
             "TopologyOptions::max_zipper_alignments", "must be in [1, 4]");
+    require(std::isfinite(merge_spacing_fraction) && merge_spacing_fraction >= 0.0,
+            "TopologyOptions::merge_spacing_fraction", "must be finite and >= 0");
     separation.validate();
 }
 

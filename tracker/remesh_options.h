@@ -68,6 +68,10 @@ struct TopologyOptions {
     double merge_distance_fraction = 0.1;
     /// Closed-form zipper alignments tried per pair (cheapest first), in [1, 4].
     int max_zipper_alignments = 4;
+    /// Within one pass, a pair closer than this fraction of ξ to a pair already merged in that
+    /// pass is left for a later step, so one contact patch opens one neck instead of several
+    /// tubes (handles) at once; ≥ 0, and 0 merges every pair as the paper's §3.7 does.
+    double merge_spacing_fraction = 4.0;
     SeparationOptions separation;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };

@@ -73,6 +73,34 @@ TEST(Merge, TwoTouchingSpheresBecomeOneSphere) {
     EXPECT_EQ(euler_characteristic(mesh), 2);
 }
 
+TEST(Merge, OneContactPatchOpensOneNeckUnlessSpacingIsOff) {
+    // Closer than the merge distance over a wide patch: many proximal pairs. The default
+    // spacing merges the nearest pair only (one neck, χ = 2); spacing 0 merges every pair it
+    // can, as the paper's §3.7 does, and creates handles.
+    constexpr double RADIUS = 0.2, GAP = 2e-4, EDGE = 0.05;
+    const SurfaceMesh initial = testing::make_two_spheres(RADIUS, GAP, EDGE);
+    TopologyOptions options;
+    options.merge_distance_fraction = 0.3;
+    TopologyContext context;
+    context.xi = testing::mean_edge_length(initial);
+
+    SurfaceMesh spaced = initial;
+    const TopologyReport r = change_topology(spaced, options, context);
+    EXPECT_EQ(r.merge.merges, 1);
+    EXPECT_GT(r.merge.deferred_near_merge, 0);
+    expect_valid(spaced, "spaced merging");
+    EXPECT_EQ(triangle_components(spaced).count, 1);
+    EXPECT_EQ(euler_characteristic(spaced), 2);
+
+    SurfaceMesh every = initial;
+    options.merge_spacing_fraction = 0.0;
+    const TopologyReport all = change_topology(every, options, context);
+    EXPECT_GT(all.merge.merges, 1);
+    expect_valid(every, "merging every pair");
+    EXPECT_EQ(triangle_components(every).count, 1);
+    EXPECT_EQ(euler_characteristic(every), 4 - 2 * all.merge.merges);
+}
+
 TEST(Merge, SpheresPushedTogetherMergeWhileEveryStepStaysValidAndIntersectionFree) {
     // A small time loop: both spheres are pushed towards each other every step (collision
     // resolution stops them), then improved and merged. Pushing on after contact keeps creating

@@ -38,6 +38,7 @@ double alignment_cost(const SurfaceMesh& mesh, const EdgeHole& a, const EdgeHole
 struct Candidate {
     double distance;
     Edge a, b;
+    Vec3 midpoint;  ///< between the two closest points
 };
 
 }  // namespace
@@ -137,8 +138,11 @@ MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& optio
             const Edge& b = mesh.edge(pair.ej);
             const EdgeEdgeProximity p = edge_edge_proximity(
                 mesh.position(a[0]), mesh.position(a[1]), mesh.position(b[0]), mesh.position(b[1]));
-            if (p.distance < merge_distance)
-                candidates.push_back({p.distance, a, b});
+            if (p.distance < merge_distance) {
+                const Vec3 on_a = (1.0 - p.s) * mesh.position(a[0]) + p.s * mesh.position(a[1]);
+                const Vec3 on_b = (1.0 - p.u) * mesh.position(b[0]) + p.u * mesh.position(b[1]);
+                candidates.push_back({p.distance, a, b, 0.5 * (on_a + on_b)});
+            }
         }
     }
     report.candidates = static_cast<int>(candidates.size());
@@ -158,7 +162,16 @@ MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& optio
     if (context.collision_safety)
         hash = std::make_unique<ElementHash>(mesh, context.xi);
 
+    const double spacing = options.merge_spacing_fraction * context.xi;
+    std::vector<Vec3> merged_at;
     for (const Candidate& c : candidates) {
+        const bool near_merge = std::any_of(merged_at.begin(), merged_at.end(), [&](const Vec3& m) {
+            return (m - c.midpoint).squaredNorm() < spacing * spacing;
+        });
+        if (near_merge) {
+            ++report.deferred_near_merge;
+            continue;
+        }
         const int ea = mesh.find_edge(c.a[0], c.a[1]);
         const int eb = mesh.find_edge(c.b[0], c.b[1]);
         EdgeHole hole_a, hole_b;
@@ -209,6 +222,7 @@ MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& optio
         if (hash)
             hash->refresh(mesh, touched);
         ++report.merges;
+        merged_at.push_back(c.midpoint);
     }
     report.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

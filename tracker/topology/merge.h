@@ -20,6 +20,7 @@ struct MergeReport {
     int candidates = 0;  ///< edge pairs closer than the merge distance
     int merges = 0;
     int stale = 0;                  ///< pairs whose edges an earlier merge changed or removed
+    int deferred_near_merge = 0;    ///< pairs left for later: too close to a merge of this pass
     int refused_shared_vertex = 0;  ///< the two holes would share a vertex
     int refused_boundary = 0;       ///< a hole would touch an open boundary
     int refused_existing_edge = 0;  ///< the band would recreate an existing edge
@@ -54,7 +55,8 @@ bool merge_creates_existing_edge(const SurfaceMesh& mesh, const EdgeHole& a,
 bool merge_intersects(const SurfaceMesh& mesh, const ElementHash& hash, const EdgeHole& a,
                       const EdgeHole& b, const std::vector<Triangle>& band);
 
-/// Finds edge pairs closer than merge_distance_fraction · xi and merges them nearest first.
+/// Finds edge pairs closer than merge_distance_fraction · xi and merges them nearest first,
+/// deferring pairs within merge_spacing_fraction · xi of a merge made earlier in the pass.
 /// With `collision_safety` off the intersection check is skipped. Does not separate: call
 /// separate() afterwards (change_topology does).
 MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& options,
