@@ -180,6 +180,32 @@ TEST(Rasterize, PoolFillingTheDomainWithAGasBubbleInside) {
     }
 }
 
+TEST(Rasterize, DropInsideABubbleInsideAPool) {
+    const int n = 32;
+    const fluid::MacGrid grid = unit_grid(n);
+    const double dx = grid.dx();
+    const Vector3d centre(0.02, -0.03, 0.01);
+    const double bubble_radius = 0.35;
+    const double drop_radius = 0.15;
+    const SurfaceMesh pool = box_mesh(Vector3d::Constant(-0.5 - dx), Vector3d::Constant(0.5 + dx));
+    const SurfaceMesh bubble = sphere_mesh(centre, bubble_radius, 0.5 * dx);
+    const SurfaceMesh drop = sphere_mesh(centre, drop_radius, 0.5 * dx);
+    const SurfaceMesh mesh =
+        combine({{&pool, DROP_LABELS}, {&bubble, BUBBLE_LABELS}, {&drop, DROP_LABELS}});
+    const RasterizeResult raster = rasterize_mesh(mesh, grid);
+    int wrong_signs = 0;
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const double r = (grid.cell_centre(i, j, k) - centre).norm();
+                // Liquid in the drop and outside the bubble: φ = min(r − r_d, r_b − r).
+                const double exact = std::min(r - drop_radius, bubble_radius - r);
+                if (std::abs(exact) > 0.05 * dx && (raster.phi(i, j, k) < 0.0) != (exact < 0.0))
+                    ++wrong_signs;
+            }
+    EXPECT_EQ(wrong_signs, 0);
+}
+
 TEST(Rasterize, PoolWhollyOutsideTheBandIsLiquidAndEmptyMeshIsGas) {
     const int n = 16;
     const fluid::MacGrid grid = unit_grid(n);

@@ -53,10 +53,12 @@ CurvatureError sphere_curvature_error(const fluid::InterfaceInput& in, double ex
     return error;
 }
 
-TEST(SurfaceTension, SphereCurvatureAtCrossingsConvergesToTwoOverR) {
+TEST(SurfaceTension, SphereCurvatureAtCrossingsIsTwoOverR) {
+    // The mesher puts the vertices on the sphere, so the cotangent curvature is accurate at
+    // every resolution; its pointwise scatter does not shrink (Meyer et al.'s operator is not
+    // pointwise convergent on irregular meshes) but stays at a few per cent.
     const double radius = 0.3;
     const Vector3d centre(0.503, 0.497, 0.511);
-    std::vector<CurvatureError> errors;
     for (int n : {16, 32, 64}) {
         const fluid::MacGrid grid(n, n, n, 1.0 / n);
         const tracker::SurfaceMesh mesh = sphere_mesh(centre, radius, 1.0 / n);
@@ -67,15 +69,73 @@ TEST(SurfaceTension, SphereCurvatureAtCrossingsConvergesToTwoOverR) {
         EXPECT_EQ(error.faces, result.crossed_faces);
         std::printf(
             "sphere, %5.1f cells per diameter, edge = dx: %lld crossed faces, "
-            "|kappa R/2 - 1| mean %.4f max %.4f (faces %.4f s)\n",
+            "|kappa R/2 - 1| mean %.5f max %.4f (faces %.4f s)\n",
             2.0 * radius * n, error.faces, error.mean, error.max, result.face_seconds);
-        errors.push_back(error);
+        EXPECT_LT(error.mean, 0.005);
+        EXPECT_LT(error.max, 0.05);
     }
-    EXPECT_LT(errors[0].mean, 0.03);
-    for (size_t r = 1; r < errors.size(); ++r) {
-        EXPECT_LT(errors[r].mean, errors[r - 1].mean);
-        EXPECT_LT(errors[r].max, 0.05);
+}
+
+/// κ (1/m, sum of principal curvatures, outward normal) of the ellipsoid Σ (xᵢ/aᵢ)² = 1 centred
+/// at the origin, at its point p: div(∇F/|∇F|) with F = Σ (xᵢ/aᵢ)².
+double ellipsoid_curvature(const Vector3d& radii, const Vector3d& p) {
+    const Vector3d inverse_squares = radii.cwiseProduct(radii).cwiseInverse();
+    const Vector3d half_gradient = p.cwiseProduct(inverse_squares);
+    const double g2 = half_gradient.squaredNorm();
+    return (g2 * inverse_squares.sum() -
+            half_gradient.cwiseProduct(half_gradient).dot(inverse_squares)) /
+           std::pow(g2, 1.5);
+}
+
+TEST(SurfaceTension, EllipsoidCurvatureAtCrossingsConvergesUnderRefinement) {
+    // κ varies over the surface, so where each crossing samples the mesh matters. Mesh edge = dx.
+    const Vector3d centre(0.503, 0.497, 0.511);
+    const Vector3d radii(0.32, 0.24, 0.18);
+    const tracker::ShapePtr shape = tracker::make_ellipsoid(centre, radii);
+    constexpr int PROJECTION_STEPS = 20;
+    std::vector<double> rms_errors;
+    for (int n : {16, 32, 64}) {
+        const fluid::MacGrid grid(n, n, n, 1.0 / n);
+        tracker::ImplicitMeshOptions mesher;
+        mesher.edge_length = 1.0 / n;
+        const tracker::SurfaceMesh mesh = tracker::mesh_implicit_shape(*shape, mesher);
+        const fluid::InterfaceInput in = interface_from_mesh(mesh, grid);
+        double sum_squares = 0.0;
+        double max_error = 0.0;
+        long long faces = 0;
+        for (int axis = 0; axis < 3; ++axis) {
+            const fluid::Array3<double>& kappa = in.kappa(axis);
+            const int di = axis == 0, dj = axis == 1, dk = axis == 2;
+            for (int k = dk; k < kappa.nk() - dk; ++k)
+                for (int j = dj; j < kappa.nj() - dj; ++j)
+                    for (int i = di; i < kappa.ni() - di; ++i) {
+                        const double phi_lo = in.phi(i - di, j - dj, k - dk);
+                        const double phi_hi = in.phi(i, j, k);
+                        if (fluid::is_liquid(phi_lo) == fluid::is_liquid(phi_hi))
+                            continue;
+                        const Vector3d x_lo = grid.cell_centre(i - di, j - dj, k - dk);
+                        const Vector3d x =
+                            x_lo + phi_lo / (phi_lo - phi_hi) * (grid.cell_centre(i, j, k) - x_lo);
+                        const Vector3d on_surface =
+                            tracker::project_to_zero_set(*shape, x, PROJECTION_STEPS);
+                        const double exact = ellipsoid_curvature(radii, on_surface - centre);
+                        const double error = kappa(i, j, k) / exact - 1.0;
+                        sum_squares += error * error;
+                        max_error = std::max(max_error, std::abs(error));
+                        ++faces;
+                    }
+        }
+        const double rms = std::sqrt(sum_squares / static_cast<double>(faces));
+        std::printf(
+            "ellipsoid, dx = 1/%d, edge = dx: relative kappa error rms %.4f max %.4f "
+            "over %lld crossed faces\n",
+            n, rms, max_error, faces);
+        EXPECT_LT(max_error, 0.1);
+        rms_errors.push_back(rms);
     }
+    for (size_t r = 1; r < rms_errors.size(); ++r)
+        EXPECT_LT(rms_errors[r], rms_errors[r - 1]);
+    EXPECT_LT(rms_errors.back(), 0.01);
 }
 
 TEST(SurfaceTension, SmoothingReducesTheScatterOfAnIrregularMesh) {
@@ -114,9 +174,16 @@ TEST(SurfaceTension, BubbleHasNegativeCurvature) {
     EXPECT_LT(error.mean, 0.03);
 }
 
-TEST(SurfaceTension, StaticDropThroughTheFluidSolverHasTheLaplaceJump) {
-    // 16.6 cells per diameter, density ratio 1000, no gravity.
-    const int n = 32;
+/// Laplace jump (mean pressure well inside minus well outside) and max|u| of a static drop of
+/// radius 0.26 in the unit box after `steps` capillary-limited steps.
+struct StaticDrop {
+    double jump = 0.0;
+    double laplace = 0.0;
+    double max_u = 0.0;
+    double capillary_number = 0.0;  ///< max|u| sqrt(ρ_l D / σ)
+};
+
+StaticDrop static_drop(int n, int smoothing_passes, int steps) {
     const double dx = 1.0 / n;
     const double radius = 0.26;
     fluid::FluidOptions options;
@@ -126,42 +193,59 @@ TEST(SurfaceTension, StaticDropThroughTheFluidSolverHasTheLaplaceJump) {
     options.gravity = Vector3d::Zero();
     fluid::FluidSolver solver(n, n, n, dx, Vector3d::Zero(), options);
     const tracker::SurfaceMesh mesh = sphere_mesh(Vector3d(0.5, 0.49, 0.51), radius, dx);
-    const fluid::InterfaceInput in = interface_from_mesh(mesh, solver.grid());
+    SurfaceTensionOptions tension;
+    tension.smoothing_passes = smoothing_passes;
+    const fluid::InterfaceInput in = interface_from_mesh(mesh, solver.grid(), {}, tension);
 
-    const int steps = 5;
     const double dt = solver.time_step_limits().dt;
     for (int step = 0; step < steps; ++step) {
         const fluid::StepResult result = solver.step(dt, in);
-        ASSERT_TRUE(result.pressure.converged);
+        EXPECT_TRUE(result.pressure.converged);
     }
-    const double well = 3.0 * dx;
+    constexpr double WELL_CELLS = 3.0;
     double inside = 0.0, outside = 0.0;
     long long n_inside = 0, n_outside = 0;
     for (int k = 0; k < n; ++k)
         for (int j = 0; j < n; ++j)
             for (int i = 0; i < n; ++i) {
                 const double phi = in.phi(i, j, k);
-                if (phi < -well) {
+                if (phi < -WELL_CELLS * dx) {
                     inside += solver.pressure()(i, j, k);
                     ++n_inside;
-                } else if (phi > well) {
+                } else if (phi > WELL_CELLS * dx) {
                     outside += solver.pressure()(i, j, k);
                     ++n_outside;
                 }
             }
-    ASSERT_GT(n_inside, 0);
-    ASSERT_GT(n_outside, 0);
-    const double jump = inside / n_inside - outside / n_outside;
-    const double laplace = 2.0 * options.phases.sigma / radius;
-    const double max_u = solver.grid().max_abs_velocity().maxCoeff();
-    const double diameter = 2.0 * radius;
+    EXPECT_GT(n_inside, 0);
+    EXPECT_GT(n_outside, 0);
+    StaticDrop drop;
+    drop.jump = inside / static_cast<double>(n_inside) - outside / static_cast<double>(n_outside);
+    drop.laplace = 2.0 * options.phases.sigma / radius;
+    drop.max_u = solver.grid().max_abs_velocity().maxCoeff();
+    drop.capillary_number =
+        drop.max_u * std::sqrt(options.phases.rho_liquid * 2.0 * radius / options.phases.sigma);
     std::printf(
-        "static drop, %.1f cells per diameter: jump %.5f Pa vs 2 sigma/R = %.5f Pa "
-        "(error %.3f %%); after %d steps of %.2e s max|u| = %.3e m/s, "
+        "static drop, %.1f cells per diameter, %d smoothing passes: jump %.6f Pa vs "
+        "2 sigma/R = %.6f Pa (error %+.4f %%); after %d steps of %.3f s max|u| = %.3e m/s, "
         "max|u| sqrt(rho D / sigma) = %.3e\n",
-        diameter / dx, jump, laplace, 100.0 * (jump / laplace - 1.0), steps, dt, max_u,
-        max_u * std::sqrt(options.phases.rho_liquid * diameter / options.phases.sigma));
-    EXPECT_NEAR(jump, laplace, 0.02 * laplace);
+        2.0 * radius * n, smoothing_passes, drop.jump, drop.laplace,
+        100.0 * (drop.jump / drop.laplace - 1.0), steps, dt, drop.max_u, drop.capillary_number);
+    return drop;
+}
+
+TEST(SurfaceTension, StaticDropThroughTheFluidSolverHasTheLaplaceJump) {
+    // Density ratio 1000, no gravity, φ and κ from the coupling; 16.6 and 25 cells per diameter.
+    constexpr int STEPS = 5;
+    constexpr int SMOOTHING_PASSES = 2;
+    for (int n : {32, 48}) {
+        const StaticDrop raw = static_drop(n, 0, STEPS);
+        const StaticDrop smoothed = static_drop(n, SMOOTHING_PASSES, STEPS);
+        EXPECT_NEAR(raw.jump, raw.laplace, 0.02 * raw.laplace);
+        EXPECT_NEAR(smoothed.jump, smoothed.laplace, 0.02 * smoothed.laplace);
+        // Spurious currents come from the scatter of κ between faces: smoothing reduces them.
+        EXPECT_LT(smoothed.max_u, raw.max_u);
+    }
 }
 
 TEST(SurfaceTension, InvalidOptionsAndMismatchedRasterAreRejected) {
