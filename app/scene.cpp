@@ -56,6 +56,88 @@ void visit_fields(V& v, OutputOptions& o) {
 }
 
 template <typename V>
+void visit_fields(V& v, tracker::CollisionOptions& o) {
+    v.boolean("repulsion", o.repulsion, "proximity repulsion impulses before CCD (paper §3.8)");
+    v.integer("impulse_sweeps", o.impulse_sweeps, Range::between(0, 100), "",
+              "sweeps of individual CCD impulses before impact zones (paper: 3)");
+    v.integer("max_impact_zone_iterations", o.max_impact_zone_iterations, Range::between(1, 10000),
+              "", "bound on impact-zone detect/solve rounds");
+    v.integer("max_rigid_zone_iterations", o.max_rigid_zone_iterations, Range::between(0, 10000),
+              "", "bound on rigid impact-zone rounds (fallback)");
+    v.integer("max_step_shortenings", o.max_step_shortenings, Range::between(0, 60), "",
+              "halvings of the motion tried before the mesh is left in place (last fallback)");
+}
+
+template <typename V>
+void visit_fields(V& v, tracker::RemeshOptions& o) {
+    v.boolean("split", o.split, "split edges longer than α (§3.5.1)");
+    v.boolean("flip", o.flip, "flip non-Delaunay edges (§3.5.2)");
+    v.boolean("collapse", o.collapse, "collapse edges shorter than β (§3.5.3)");
+    v.boolean("smooth", o.smooth, "null-space smoothing (§3.6.1)");
+    v.number("max_edge_fraction", o.max_edge_fraction, Range::positive(), "ξ",
+             "α: maximum edge length");
+    v.number("min_edge_fraction", o.min_edge_fraction, Range::positive(), "ξ",
+             "β: minimum edge length");
+    v.number("max_volume_change_fraction", o.max_volume_change_fraction, Range::positive(), "ξ³",
+             "γ: largest volume change of one flip or collapse");
+    v.integer("max_split_passes", o.max_split_passes, Range::between(1, 100), "",
+              "sweeps over long edges per step");
+    v.integer("max_collapse_passes", o.max_collapse_passes, Range::between(1, 100), "",
+              "sweeps over short edges per step");
+    v.integer("max_flip_sweeps", o.max_flip_sweeps, Range::between(1, 100), "",
+              "flip sweeps per step (paper: 5)");
+    v.number("min_flip_length_decrease_fraction", o.min_flip_length_decrease_fraction,
+             Range{0.0, 1.0, false, true}, "", "a flip must shorten the edge by this fraction");
+    v.integer("collapse_position_attempts", o.collapse_position_attempts, Range::between(1, 100),
+              "", "collapse trajectories tried from the butterfly position towards the midpoint");
+    v.number("max_normal_change_degrees", o.max_normal_change_degrees,
+             Range{0.0, 180.0, true, false}, "degrees",
+             "largest triangle normal change allowed by a collapse or flip");
+    v.number("ridge_eigenvalue_ratio", o.ridge_eigenvalue_ratio, Range{0.0, 1.0, true, true}, "",
+             "quadric metric λ₂/λ₁ above which a vertex is on a ridge");
+    v.number("corner_eigenvalue_ratio", o.corner_eigenvalue_ratio, Range{0.0, 1.0, true, true}, "",
+             "quadric metric λ₃/λ₁ above which a vertex is a corner");
+    v.integer("smoothing_iterations", o.smoothing_iterations, Range::between(0, 100), "",
+              "null-space smoothing steps per improvement");
+    v.number("smoothing_step_fraction", o.smoothing_step_fraction, Range{0.0, 1.0, true, false}, "",
+             "fraction of the smoothing displacement applied per step");
+}
+
+template <typename V>
+void visit_fields(V& v, tracker::TopologyOptions& o) {
+    v.boolean("allow_merging", o.allow_merging, "zipper proximal edge pairs (§3.7)");
+    v.boolean("allow_separation", o.allow_separation,
+              "remove degenerate tetrahedra and split singular vertices (§3.6)");
+    v.number("merge_distance_fraction", o.merge_distance_fraction, Range::positive(), "ξ",
+             "edge pairs closer than this merge (must exceed /tracker/proximity_fraction)");
+    v.integer("max_zipper_alignments", o.max_zipper_alignments, Range::between(1, 4), "",
+              "closed-form zipper alignments tried per pair");
+    v.section("separation", "separation of pinched surfaces", [&](auto& r) {
+        r.number("nudge_fraction", o.separation.nudge_fraction, Range{0.0, 0.5, true, true}, "",
+                 "copies of a singular vertex move this fraction towards their fan's centroid");
+        r.integer("max_nudge_halvings", o.separation.max_nudge_halvings, Range::between(0, 60), "",
+                  "halvings of the nudge tried when the nudged fans would intersect");
+    });
+}
+
+template <typename V>
+void visit_fields(V& v, tracker::TrackerOptions& o) {
+    v.boolean("improve_mesh", o.improve_mesh, "mesh improvement on/off (paper §3.3 switch)");
+    v.boolean("allow_topology_changes", o.allow_topology_changes,
+              "merging and pinch-off on/off (paper §3.3 switch)");
+    v.boolean("collision_safety", o.collision_safety,
+              "keep the mesh intersection-free (paper §3.3 switch; off shows why it exists)");
+    v.number("proximity_fraction", o.proximity_fraction, Range::positive(), "ξ",
+             "repulsion distance ε_p as a fraction of the initial mean edge length ξ");
+    v.boolean("verify_intersection_free", o.verify_intersection_free,
+              "run the exact static self-intersection test after every step and report it");
+    v.section("collision", "collision resolution bounds",
+              [&](auto& r) { visit_fields(r, o.collision); });
+    v.section("remesh", "mesh improvement", [&](auto& r) { visit_fields(r, o.remesh); });
+    v.section("topology", "topology changes", [&](auto& r) { visit_fields(r, o.topology); });
+}
+
+template <typename V>
 void visit_fields(V& v, Scene& s) {
     v.text("name", s.name, "scene name, used in logs");
     v.text("description", s.description, "free text");
@@ -63,6 +145,8 @@ void visit_fields(V& v, Scene& s) {
         visit_fields(r, s.surface);
         r.known("shape");  // the shape tree is parsed by parse_shape()
     });
+    v.section("tracker", "the explicit surface tracker",
+              [&](auto& r) { visit_fields(r, s.tracker); });
     v.section("flow", "the velocity field that moves the surface",
               [&](auto& r) { visit_fields(r, s.flow); });
     v.section("time", "simulated time and frames", [&](auto& r) { visit_fields(r, s.time); });
@@ -258,6 +342,11 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
         if (j.contains("surface") && j["surface"].is_object() && j["surface"].contains("shape"))
             scene.shape = parse_shape(j["surface"]["shape"], "/surface/shape");
         root.finish();
+        try {
+            scene.tracker.validate();
+        } catch (const std::invalid_argument& e) {
+            throw SceneError(std::string("/tracker/") + e.what());
+        }
         if (!scene.shape && scene.surface.mesh_file.empty())
             throw SceneError("/surface: give either `shape` or `mesh_file`");
         if (scene.shape && !scene.surface.mesh_file.empty())

@@ -3,6 +3,7 @@
 /// the struct below and nowhere else; `meniscus scene-reference` prints them all.
 
 #include "tracker/implicit_shape.h"
+#include "tracker/surface_tracker.h"
 
 #include <Eigen/Core>
 
@@ -46,6 +47,7 @@ struct Scene {
     std::string description;
     SurfaceOptions surface;
     tracker::ShapePtr shape;  ///< set when the scene gives /surface/shape
+    tracker::TrackerOptions tracker;
     FlowOptions flow;
     TimeOptions time;
     OutputOptions output;

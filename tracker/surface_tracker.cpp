@@ -13,6 +13,16 @@ namespace meniscus::tracker {
 void TrackerOptions::validate() const {
     if (!(proximity_fraction > 0.0) || !std::isfinite(proximity_fraction))
         throw std::invalid_argument("proximity_fraction: expected a number > 0");
+    try {
+        remesh.validate();
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("remesh/") + e.what());
+    }
+    try {
+        topology.validate();
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("topology/") + e.what());
+    }
     CollisionOptions c = collision;
     c.proximity_epsilon = 1.0;  // overwritten from proximity_fraction; validate the rest
     try {
@@ -29,6 +39,31 @@ SurfaceTracker::SurfaceTracker(SurfaceMesh mesh, const TrackerOptions& options)
     if (!(m_xi > 0.0))
         throw std::invalid_argument("SurfaceTracker: the mesh has no edges");
     m_options.collision.proximity_epsilon = m_options.proximity_fraction * m_xi;
+}
+
+ImproveReport SurfaceTracker::improve() {
+    if (!m_options.improve_mesh)
+        return {};
+    ImproveContext context;
+    context.xi = m_xi;
+    context.collision_safety = m_options.collision_safety;
+    context.allow_topology_changes = m_options.allow_topology_changes;
+    context.collision = m_options.collision;
+    context.separation = m_options.topology.separation;
+    return improve_mesh(m_mesh, m_options.remesh, context);
+}
+
+TopologyReport SurfaceTracker::change_topology() {
+    TopologyReport report;
+    if (m_options.allow_topology_changes) {
+        TopologyContext context;
+        context.xi = m_xi;
+        context.collision_safety = m_options.collision_safety;
+        report = meniscus::tracker::change_topology(m_mesh, m_options.topology, context);
+    }
+    if (m_mesh.has_dead_elements())
+        m_mesh.compact();
+    return report;
 }
 
 IntegrateResult SurfaceTracker::integrate(const std::vector<Vec3>& velocities, double dt) {

@@ -5,6 +5,9 @@
 
 #include "tracker/collision_resolution.h"
 #include "tracker/mesh.h"
+#include "tracker/remesh/improve.h"
+#include "tracker/remesh_options.h"
+#include "tracker/topology/change_topology.h"
 
 #include <vector>
 
@@ -13,7 +16,9 @@ namespace meniscus::tracker {
 /// Options of the tracker. Lengths are fractions of ξ, the mean edge length of the mesh the
 /// tracker was created with, so a scene scales without retuning.
 struct TrackerOptions {
-    bool collision_safety = true;  ///< §3.3 switch: enforce intersection-free motion
+    bool improve_mesh = true;            ///< §3.3 switch: split, flip, collapse, smooth
+    bool allow_topology_changes = true;  ///< §3.3 switch: merging and separation
+    bool collision_safety = true;        ///< §3.3 switch: enforce intersection-free motion
     /// ε_p as a fraction of ξ (repulsion distance of collision resolution).
     double proximity_fraction = 1e-3;
     /// Run the exact static self-intersection test after every integrate() and report it.
@@ -21,7 +26,9 @@ struct TrackerOptions {
     /// Collision resolution tuning; its proximity_epsilon is overwritten from
     /// proximity_fraction · ξ.
     CollisionOptions collision;
-    void validate() const;  ///< throws std::invalid_argument naming the field
+    RemeshOptions remesh;      ///< α, β, γ as fractions of ξ and the operations' switches
+    TopologyOptions topology;  ///< merge distance and separation
+    void validate() const;     ///< throws std::invalid_argument naming the field
 };
 
 /// What one integrate() call did.
@@ -44,6 +51,15 @@ public:
     const TrackerOptions& options() const { return m_options; }
     /// ξ: mean edge length of the initial mesh (metres).
     double characteristic_length() const { return m_xi; }
+
+    /// Mesh improvement of one step (paper §3.5, §3.6.1): an empty report when improve_mesh is
+    /// off. Leaves dead slots; call compact() (or change_topology(), which compacts) after.
+    ImproveReport improve();
+    /// Topology changes of one step (§3.6, §3.7) when allowed, then compact(): vertex indices
+    /// may change (observers registered on mesh() are told).
+    TopologyReport change_topology();
+    /// Removes dead slots (see SurfaceMesh::compact).
+    void compact() { m_mesh.compact(); }
 
     /// Moves every live vertex by velocities[vi] · dt (velocities sized mesh().num_vertices()),
     /// changed as little as needed to keep the mesh intersection-free when collision safety is
