@@ -43,8 +43,14 @@ TEST(Scene, DefaultsComeFromTheStructs) {
 }
 
 TEST(Scene, ErrorsNameTheJsonPath) {
-    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "tracker": {}})")
-                  .find("test.json: /tracker: unknown key"),
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "fluids": {}})")
+                  .find("test.json: /fluids: unknown key"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "tracker": {"remesh": {"max_edge_fractoin": 2}}})")
+                  .find("/tracker/remesh/max_edge_fractoin: unknown key"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "tracker": {"remesh": {"max_edge_fraction": -1}}})")
+                  .find("/tracker/remesh/max_edge_fraction: expected a number > 0"),
               std::string::npos);
     EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere", "radius": "big"}}})")
                   .find("/surface/shape/radius: expected a number > 0, got a string"),
