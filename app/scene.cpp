@@ -112,6 +112,8 @@ void visit_fields(V& v, tracker::TopologyOptions& o) {
              "edge pairs closer than this merge (must exceed /tracker/proximity_fraction)");
     v.integer("max_zipper_alignments", o.max_zipper_alignments, Range::between(1, 4), "",
               "closed-form zipper alignments tried per pair");
+    v.number("merge_spacing_fraction", o.merge_spacing_fraction, Range::non_negative(), "ξ",
+             "within one step, pairs closer than this to a merge already made wait (0 = none)");
     v.section("separation", "separation of pinched surfaces", [&](auto& r) {
         r.number("nudge_fraction", o.separation.nudge_fraction, Range{0.0, 0.5, true, true}, "",
                  "copies of a singular vertex move this fraction towards their fan's centroid");

@@ -23,6 +23,11 @@ void TrackerOptions::validate() const {
     } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(std::string("topology/") + e.what());
     }
+    if (allow_topology_changes && topology.allow_merging &&
+        !(topology.merge_distance_fraction > proximity_fraction))
+        throw std::invalid_argument(
+            "topology/merge_distance_fraction: must exceed proximity_fraction, or approaching "
+            "surfaces are held apart by repulsion before they come close enough to merge");
     CollisionOptions c = collision;
     c.proximity_epsilon = 1.0;  // overwritten from proximity_fraction; validate the rest
     try {

@@ -68,6 +68,9 @@ TEST(Scene, ErrorsNameTheJsonPath) {
     EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "box", "min": [0, 0]}}})")
                   .find("/surface/shape/min: expected an array of 3 numbers"),
               std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "tracker": {"proximity_fraction": 0.5}})")
+                  .find("/tracker/topology/merge_distance_fraction: must exceed proximity_fraction"),
+              std::string::npos);
     EXPECT_NE(error_of(R"({"surface": {}})").find("/surface: give either `shape` or `mesh_file`"),
               std::string::npos);
     EXPECT_NE(error_of(R"({"time": {"frames": 2.5}, "surface": {"shape": {"type": "sphere"}}})")
