@@ -6,10 +6,17 @@
 /// origin + (i+½, j+½, k+½)·dx (voxel size dx, transform translated by origin + ½dx), so no
 /// resampling is needed.
 ///
-/// Sign rule (several drops and bubbles at once): OpenVDB only supplies the unsigned distance and
-/// the closest triangle of every voxel in a narrow band. Each band cell then takes the region
-/// of the side of its closest triangle it lies on — `labels(ti).outside` if it lies in front of
-/// the triangle (along its normal), `labels(ti).inside` if behind — where "side" is decided by
+/// Closest triangles: OpenVDB supplies the band and a closest polygon per voxel, but that index
+/// is approximate (its band dilation hands polygons from voxel to voxel: distances from it were
+/// off by up to 0.9 dx on a meshed sphere). Each band cell therefore starts from OpenVDB's
+/// triangles of itself and its six face neighbours and walks to any triangle sharing a vertex
+/// with the current best while that one is closer; φ is the exact (double precision) distance
+/// to the triangle found.
+///
+/// Sign rule (several drops and bubbles at once): OpenVDB computes an unsigned field only (its
+/// signed mode decides inside by flood fill and ignores orientation). Each band cell takes the
+/// region of the side of its closest triangle it lies on — `labels(ti).outside` if it lies in front
+/// of the triangle (along its normal), `labels(ti).inside` if behind — where "side" is decided by
 /// the angle-weighted pseudo-normal of the closest feature (face, edge or vertex; Bærentzen and
 /// Aanæs 2005), which is exact for closed, consistently oriented, non-self-intersecting meshes.
 /// The cell is liquid iff that region is RasterizeOptions::liquid_region (1 by default, the
