@@ -31,7 +31,7 @@ constexpr double MIN_HALF_WIDTH_CELLS = 2.0;
 constexpr int AMBIENT_REGION = 0;
 /// A barycentric coordinate at or below this counts as zero when finding the closest feature.
 constexpr double BARYCENTRIC_FEATURE_TOLERANCE = 1e-9;
-/// Bound on the steps of the local walk that corrects OpenVDB's closest triangle of a cell.
+/// Bound on the steps of walk_to_closest_triangle().
 constexpr int MAX_CLOSEST_TRIANGLE_WALK = 64;
 
 using Clock = std::chrono::steady_clock;
@@ -188,9 +188,8 @@ double triangle_distance(const SurfaceMesh& mesh, int ti, const Vec3& x) {
 }
 
 /// The closest triangle to x found from `seeds` (OpenVDB's closest polygons of the cell and its
-/// face neighbours, which are approximate: its band dilation propagates them from voxel to
-/// voxel) by walking to any triangle sharing a vertex with the current best while that is
-/// strictly closer (at most MAX_CLOSEST_TRIANGLE_WALK steps).
+/// face neighbours, which are approximate: its band dilation hands them from voxel to voxel):
+/// the closest seed, then walk_to_closest_triangle().
 int closest_triangle_near(const SurfaceMesh& mesh, const std::array<int, 7>& seeds, const Vec3& x) {
     int best = tracker::INVALID_INDEX;
     double best_distance = std::numeric_limits<double>::infinity();
@@ -203,23 +202,7 @@ int closest_triangle_near(const SurfaceMesh& mesh, const std::array<int, 7>& see
             best = ti;
         }
     }
-    for (int step = 0; step < MAX_CLOSEST_TRIANGLE_WALK; ++step) {
-        const int current = best;
-        for (int vi : mesh.triangle(current)) {
-            for (int ti : mesh.vertex_triangles(vi)) {
-                if (ti == current || !mesh.triangle_alive(ti))
-                    continue;
-                const double d = triangle_distance(mesh, ti, x);
-                if (d < best_distance) {
-                    best_distance = d;
-                    best = ti;
-                }
-            }
-        }
-        if (best == current)
-            break;
-    }
-    return best;
+    return walk_to_closest_triangle(mesh, best, x);
 }
 
 /// Gives every cell outside the band (φ not yet set, marked by a zero `sign`) the sign of the
@@ -261,6 +244,31 @@ void fill_signs(std::vector<std::int8_t>& sign, int nx, int ny, int nz) {
 }
 
 }  // namespace
+
+int walk_to_closest_triangle(const tracker::SurfaceMesh& mesh, int start_ti,
+                             const Eigen::Vector3d& x) {
+    if (start_ti == tracker::INVALID_INDEX)
+        return tracker::INVALID_INDEX;
+    int best = start_ti;
+    double best_distance = triangle_distance(mesh, best, x);
+    for (int step = 0; step < MAX_CLOSEST_TRIANGLE_WALK; ++step) {
+        const int current = best;
+        for (int vi : mesh.triangle(current)) {
+            for (int ti : mesh.vertex_triangles(vi)) {
+                if (ti == current || !mesh.triangle_alive(ti))
+                    continue;
+                const double d = triangle_distance(mesh, ti, x);
+                if (d < best_distance) {
+                    best_distance = d;
+                    best = ti;
+                }
+            }
+        }
+        if (best == current)
+            break;
+    }
+    return best;
+}
 
 void RasterizeOptions::validate() const {
     if (!(half_width_cells >= MIN_HALF_WIDTH_CELLS) || !std::isfinite(half_width_cells))

@@ -78,4 +78,11 @@ struct RasterizeResult {
 RasterizeResult rasterize_mesh(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
                                const RasterizeOptions& options = {});
 
+/// Local closest-triangle search: from live triangle `start_ti`, repeatedly moves to the live
+/// triangle sharing a vertex with the current one that is closest to `x` (m) while it is
+/// strictly closer (at most 64 moves), and returns where it stops — the closest triangle of the
+/// sheet around `start_ti` unless another sheet lies nearer. INVALID_INDEX for an INVALID start.
+int walk_to_closest_triangle(const tracker::SurfaceMesh& mesh, int start_ti,
+                             const Eigen::Vector3d& x);
+
 }  // namespace meniscus::coupling

@@ -160,8 +160,9 @@ SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const flu
                                 if (ti == tracker::INVALID_INDEX)
                                     continue;
                                 double distance = 0.0;
-                                const double candidate =
-                                    curvature_at_closest_point(mesh, kappa, ti, x, distance);
+                                const double candidate = curvature_at_closest_point(
+                                    mesh, kappa, walk_to_closest_triangle(mesh, ti, x), x,
+                                    distance);
                                 if (distance < best) {
                                     best = distance;
                                     value = candidate;

@@ -4,9 +4,10 @@
 ///
 /// κ comes from the mesh, not from derivatives of φ: the cotangent mean curvature at vertices
 /// (tracker/flows/mean_curvature.h, Meyer et al. 2003), optionally smoothed by area-weighted
-/// one-ring averaging, then interpolated barycentrically at the point of the closest triangle
-/// nearest to each crossing x = x_lo + θ (x_hi − x_lo), θ = φ_lo / (φ_lo − φ_hi), between the
-/// centres of the two cells next to the face.
+/// one-ring averaging, then interpolated barycentrically at the point of the mesh closest to each
+/// crossing x = x_lo + θ (x_hi − x_lo), θ = φ_lo / (φ_lo − φ_hi), between the centres of the two
+/// cells next to the face; the closest triangle is found by walk_to_closest_triangle() from the
+/// closest triangles of those two cells.
 ///
 /// Sign: the fluid's convention — κ > 0 for a convex liquid blob (a drop), < 0 around a gas
 /// bubble. The mesh's per-vertex κ is positive where the surface is convex as seen from the side

@@ -2,6 +2,7 @@
 // distances in the band, |∇φ| ≈ 1, and the timing/bookkeeping of the result.
 #include "coupling/rasterize.h"
 
+#include "tracker/distance.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/implicit_shape.h"
 
@@ -271,6 +272,39 @@ TEST(Rasterize, DeadTrianglesAreSkippedAndOptionsValidated) {
     RasterizeOptions options;
     options.half_width_cells = 1.0;
     EXPECT_THROW(rasterize_mesh(mesh, grid, options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace meniscus::coupling
+
+namespace meniscus::coupling {
+namespace {
+
+TEST(Rasterize, WalkToClosestTriangleMatchesBruteForceOnASphere) {
+    const SurfaceMesh mesh = sphere_mesh(Vector3d::Zero(), 0.3, 0.05);
+    int mismatches = 0;
+    for (const Vector3d& x : {Vector3d(0.31, 0.02, -0.01), Vector3d(-0.05, 0.28, 0.1),
+                              Vector3d(0.1, -0.1, -0.25), Vector3d(0.0, 0.0, 0.2)}) {
+        int brute = tracker::INVALID_INDEX;
+        double brute_distance = 1e300;
+        for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+            const tracker::Triangle& t = mesh.triangle(ti);
+            const double d = tracker::point_triangle_proximity(
+                                 x, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]))
+                                 .distance;
+            if (d < brute_distance) {
+                brute_distance = d;
+                brute = ti;
+            }
+        }
+        // Start a quarter of the sphere away (the triangle closest to the rotated point).
+        const int start = walk_to_closest_triangle(mesh, 0, Vector3d(-x.y(), x.x(), x.z()));
+        if (walk_to_closest_triangle(mesh, start, x) != brute)
+            ++mismatches;
+    }
+    EXPECT_EQ(mismatches, 0);
+    EXPECT_EQ(walk_to_closest_triangle(mesh, tracker::INVALID_INDEX, Vector3d::Zero()),
+              tracker::INVALID_INDEX);
 }
 
 }  // namespace
