@@ -152,33 +152,63 @@ TEST(Rasterize, PoolFillingTheDomainWithAGasBubbleInside) {
     const double dx = grid.dx();
     const Vector3d centre(0.1, 0.05, -0.08);
     const double radius = 0.2;
-    // The pool's walls sit just outside the domain: cells near the walls are in its band.
-    const SurfaceMesh pool = box_mesh(Vector3d::Constant(-0.5 - dx), Vector3d::Constant(0.5 + dx));
     const SurfaceMesh bubble = sphere_mesh(centre, radius, 0.5 * dx);
-    // The bubble both ways: outward normals with labels {0, 1}, inward normals with {1, 0}.
-    const SurfaceMesh labelled = combine({{&pool, DROP_LABELS}, {&bubble, BUBBLE_LABELS}});
-    const SurfaceMesh reversed =
-        combine({{&pool, DROP_LABELS}, {&bubble, DROP_LABELS, /*reverse=*/true}});
-    for (const SurfaceMesh* mesh : {&labelled, &reversed}) {
-        const RasterizeResult raster = rasterize_mesh(*mesh, grid);
-        int wrong_signs = 0;
-        for (int k = 0; k < n; ++k)
-            for (int j = 0; j < n; ++j)
-                for (int i = 0; i < n; ++i) {
-                    const double in_bubble = radius - (grid.cell_centre(i, j, k) - centre).norm();
-                    if (std::abs(in_bubble) > 0.05 * dx &&
-                        (raster.phi(i, j, k) < 0.0) != (in_bubble < 0.0))
-                        ++wrong_signs;
-                }
-        EXPECT_EQ(wrong_signs, 0);
-        // Deep liquid between bubble and walls, deep gas in the bubble's centre.
-        const Vector3d g = grid.to_grid(centre);
-        EXPECT_GT(
-            raster.phi(static_cast<int>(g.x()), static_cast<int>(g.y()), static_cast<int>(g.z())),
-            0.0);
-        EXPECT_LT(raster.phi(n - 5, n - 5, n - 5), -2.0 * dx);
-        EXPECT_EQ(raster.closest_triangle(n - 5, n - 5, n - 5), tracker::INVALID_INDEX);
+    // The pool's walls on the domain walls, then one cell outside them; cells near its edges and
+    // corners test the edge and vertex pseudo-normals.
+    for (double wall_offset : {0.0, dx}) {
+        const SurfaceMesh pool =
+            box_mesh(Vector3d::Constant(-0.5 - wall_offset), Vector3d::Constant(0.5 + wall_offset));
+        // The bubble both ways: outward normals with labels {0, 1}, inward normals with {1, 0}.
+        const SurfaceMesh labelled = combine({{&pool, DROP_LABELS}, {&bubble, BUBBLE_LABELS}});
+        const SurfaceMesh reversed =
+            combine({{&pool, DROP_LABELS}, {&bubble, DROP_LABELS, /*reverse=*/true}});
+        for (const SurfaceMesh* mesh : {&labelled, &reversed}) {
+            const RasterizeResult raster = rasterize_mesh(*mesh, grid);
+            int wrong_signs = 0;
+            for (int k = 0; k < n; ++k)
+                for (int j = 0; j < n; ++j)
+                    for (int i = 0; i < n; ++i) {
+                        const double in_bubble =
+                            radius - (grid.cell_centre(i, j, k) - centre).norm();
+                        if (std::abs(in_bubble) > 0.05 * dx &&
+                            (raster.phi(i, j, k) < 0.0) != (in_bubble < 0.0))
+                            ++wrong_signs;
+                    }
+            EXPECT_EQ(wrong_signs, 0) << "wall offset " << wall_offset;
+            // Deep liquid between bubble and walls, deep gas in the bubble's centre.
+            const Vector3d g = grid.to_grid(centre);
+            EXPECT_GT(raster.phi(static_cast<int>(g.x()), static_cast<int>(g.y()),
+                                 static_cast<int>(g.z())),
+                      0.0);
+            EXPECT_LT(raster.phi(n - 8, n - 8, n - 8), -2.0 * dx);
+            EXPECT_EQ(raster.closest_triangle(n - 8, n - 8, n - 8), tracker::INVALID_INDEX);
+            // On the pool's walls the corner cell is liquid at distance ½dx from three faces.
+            if (wall_offset == 0.0)
+                EXPECT_NEAR(raster.phi(0, 0, 0), -0.5 * dx, 1e-12);
+        }
     }
+}
+
+TEST(Rasterize, DropCutByTheDomainWalls) {
+    const int n = 24;
+    const fluid::MacGrid grid = unit_grid(n);
+    const double dx = grid.dx();
+    const Vector3d centre(0.45, -0.47, 0.02);  // mostly outside the box through two walls
+    const double radius = 0.3;
+    const SurfaceMesh drop = sphere_mesh(centre, radius, 0.5 * dx);
+    const RasterizeResult raster = rasterize_mesh(drop, grid);
+    int wrong_signs = 0;
+    long long liquid = 0;
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const double exact = (grid.cell_centre(i, j, k) - centre).norm() - radius;
+                liquid += raster.phi(i, j, k) < 0.0;
+                if (std::abs(exact) > 0.05 * dx && (raster.phi(i, j, k) < 0.0) != (exact < 0.0))
+                    ++wrong_signs;
+            }
+    EXPECT_EQ(wrong_signs, 0);
+    EXPECT_GT(liquid, 0);
 }
 
 TEST(Rasterize, DropInsideABubbleInsideAPool) {
