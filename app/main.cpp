@@ -4,6 +4,7 @@
 #include "app/json_fields.h"
 #include "app/run.h"
 #include "app/scene.h"
+#include "app/validate.h"
 
 #include <atomic>
 #include <csignal>
@@ -39,6 +40,10 @@ const char* USAGE =
     "        stats.jsonl into DIR (default: out/). --frames N overrides the scene's frame count\n"
     "        (keeping its time per frame). Ctrl-C stops after the current step; every file\n"
     "        already written is complete.\n"
+    "  validate [--quick|--full] [--out DIR]\n"
+    "        run the paper's geometric-flow validation cases (quick: coarse, minutes; full: the\n"
+    "        paper's resolutions, hours) and write report.md, results.json and plots into DIR\n"
+    "        (default: validation/); exit code 1 if a run failed or intersected\n"
     "  scene-reference\n"
     "        print every scene key with its type, default, unit and meaning (Markdown)\n"
     "\n"
@@ -120,6 +125,20 @@ int dispatch(int argc, char** argv) {
     }
     if (command == "run")
         return command_run({args.begin() + 1, args.end()});
+    if (command == "validate") {
+        ValidateOptions options;
+        for (size_t i = 1; i < args.size(); ++i) {
+            if (args[i] == "--quick")
+                options.full = false;
+            else if (args[i] == "--full")
+                options.full = true;
+            else if (args[i] == "--out" && i + 1 < args.size())
+                options.out_dir = args[++i];
+            else
+                throw UsageError("validate: unknown or incomplete option " + args[i]);
+        }
+        return run_validation(options);
+    }
     if (command == "scene-reference") {
         std::fputs(scene_reference_markdown().c_str(), stdout);
         return EXIT_OK;

@@ -1,0 +1,28 @@
+#pragma once
+/// \file `meniscus validate`: runs the paper's geometric-flow validation cases
+/// (/work/shared/VALIDATION.md part A: A1 normal flow, A2 mean curvature, A3 Enright, A4 curl
+/// noise, A5 per-phase cost) through the collision-safe SurfaceTracker and writes, into one
+/// folder, `report.md` (our numbers beside the paper's, observed orders, per-phase seconds per
+/// step), `results.json` (every number and time series) and PNG plots made by
+/// `plot_validation.py` (written beside them; needs /usr/bin/python3 with matplotlib).
+
+#include <string>
+
+namespace meniscus::app {
+
+/// Options of run_validation().
+struct ValidateOptions {
+    /// false: the quick variants (coarsest resolution, shortened times; a few minutes, part of
+    /// the test suite). true: the paper's resolutions and end times (long).
+    bool full = false;
+    std::string out_dir = "validation";  ///< folder for report.md, results.json and plots
+    bool quiet = false;                  ///< no progress lines on stderr
+};
+
+/// Runs the validation cases and writes the report. Returns a process exit code: 0 when every
+/// run finished and every collision-safe run stayed intersection-free at every step, 1
+/// otherwise (the report says which run failed). Throws std::runtime_error if the output folder
+/// cannot be written.
+int run_validation(const ValidateOptions& options);
+
+}  // namespace meniscus::app
