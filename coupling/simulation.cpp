@@ -1,0 +1,156 @@
+#include "coupling/simulation.h"
+
+#include "tracker/mesh_measures.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace meniscus::coupling {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+void SimulationOptions::validate() const {
+    rasterize.validate();
+    surface_tension.validate();
+    interpolate.validate();
+    if (!(capillary_safety > 0.0 && capillary_safety <= 1.0))
+        throw std::invalid_argument("capillary_safety: expected a number in (0, 1]");
+}
+
+const char* to_string(StepLimit limit) {
+    switch (limit) {
+        case StepLimit::cfl:
+            return "cfl";
+        case StepLimit::capillary:
+            return "capillary";
+        case StepLimit::frame_end:
+            return "frame_end";
+        case StepLimit::max_dt:
+            return "max_dt";
+    }
+    return "unknown";
+}
+
+Simulation::Simulation(tracker::SurfaceTracker tracker, fluid::FluidSolver fluid,
+                       const SimulationOptions& options)
+    : m_tracker(std::make_unique<tracker::SurfaceTracker>(std::move(tracker))),
+      m_fluid(std::move(fluid)),
+      m_options(options) {
+    m_options.validate();
+    if (m_options.volume_correction)
+        m_volumes = std::make_unique<VolumeTracker>(m_tracker->mesh());
+    m_vertex_velocities.assign(static_cast<size_t>(m_tracker->mesh().num_vertices()),
+                               tracker::Vec3::Zero());
+}
+
+SimulationStepReport Simulation::step(double max_dt) {
+    if (!(max_dt > 0.0))
+        throw std::invalid_argument("Simulation::step: max_dt must be > 0");
+    SimulationStepReport report;
+    tracker::SurfaceMesh& mesh = m_tracker->mesh();
+    const fluid::MacGrid& grid = m_fluid.grid();
+
+    // (1) Time step.
+    const fluid::TimeStepLimits limits = m_fluid.time_step_limits();
+    const fluid::PhaseOptions& phases = m_fluid.options().phases;
+    const double h = std::min(grid.dx(), tracker::edge_length_stats(mesh).mean);
+    const double rho_mean = m_fluid.options().mode == fluid::FluidMode::two_phase
+                                ? 0.5 * (phases.rho_liquid + phases.rho_gas)
+                                : 0.5 * phases.rho_liquid;
+    const double capillary = phases.sigma > 0.0
+                                 ? m_options.capillary_safety *
+                                       std::sqrt(rho_mean * h * h * h / (2.0 * M_PI * phases.sigma))
+                                 : std::numeric_limits<double>::infinity();
+    report.dt = m_fluid.options().time_step.max_dt;
+    report.limit = StepLimit::max_dt;
+    const auto bind = [&](double candidate, StepLimit limit) {
+        if (candidate < report.dt) {
+            report.dt = candidate;
+            report.limit = limit;
+        }
+    };
+    bind(limits.cfl, StepLimit::cfl);
+    bind(capillary, StepLimit::capillary);
+    bind(max_dt, StepLimit::frame_end);
+
+    // (2) Mesh → grid.
+    auto start = Clock::now();
+    fluid::InterfaceInput interface =
+        interface_from_mesh(mesh, grid, m_options.rasterize, m_options.surface_tension);
+    report.rasterize_seconds = seconds_since(start);
+
+    // (3) Fluid.
+    start = Clock::now();
+    report.fluid = m_fluid.step(report.dt, interface);
+    m_phi = interface.phi;
+    report.fluid_seconds = seconds_since(start);
+
+    // (5, first half) Mesh improvement and topology changes happen before velocities are set.
+    start = Clock::now();
+    if (m_volumes)
+        m_volumes->begin_step();
+    report.improve = m_tracker->improve();
+    report.topology = m_tracker->change_topology();  // compacts
+    if (m_volumes)
+        report.volume = m_volumes->match_components();
+    report.tracker_seconds = seconds_since(start);
+
+    // (4) Grid → mesh.
+    start = Clock::now();
+    m_vertex_velocities =
+        interpolate_vertex_velocities(m_fluid.grid(), mesh, m_options.interpolate);
+    for (const tracker::Vec3& v : m_vertex_velocities)
+        report.max_vertex_speed = std::max(report.max_vertex_speed, v.norm());
+    report.interpolate_seconds = seconds_since(start);
+
+    // (6) Volume correction rides on the collision-safe motion; (5) integrate.
+    start = Clock::now();
+    std::vector<tracker::Vec3> velocities = m_vertex_velocities;
+    if (m_volumes)
+        m_volumes->add_correction(velocities, report.dt);
+    report.integrate = m_tracker->integrate(velocities, report.dt);
+    report.tracker_seconds += seconds_since(start);
+    m_time += report.integrate.time_advanced;
+    return report;
+}
+
+double Simulation::kinetic_energy() const {
+    const fluid::MacGrid& grid = m_fluid.grid();
+    const fluid::PhaseOptions& phases = m_fluid.options().phases;
+    const bool two_phase = m_fluid.options().mode == fluid::FluidMode::two_phase;
+    const double cell_volume = grid.dx() * grid.dx() * grid.dx();
+    const auto density = [&](int i, int j, int k) {
+        if (m_phi.size() == 0)
+            return phases.rho_liquid;
+        const double phi = m_phi(std::clamp(i, 0, grid.nx() - 1), std::clamp(j, 0, grid.ny() - 1),
+                                 std::clamp(k, 0, grid.nz() - 1));
+        return phi < 0.0 ? phases.rho_liquid : (two_phase ? phases.rho_gas : 0.0);
+    };
+    double energy = 0.0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const fluid::Array3<double>& u = grid.velocity(axis);
+        for (int k = 0; k < u.nk(); ++k)
+            for (int j = 0; j < u.nj(); ++j)
+                for (int i = 0; i < u.ni(); ++i) {
+                    // Face between cells (i−1) and i along `axis`: average their densities.
+                    const int ia = axis == 0 ? i - 1 : i, ja = axis == 1 ? j - 1 : j,
+                              ka = axis == 2 ? k - 1 : k;
+                    const double rho = 0.5 * (density(ia, ja, ka) + density(i, j, k));
+                    energy += 0.5 * rho * u(i, j, k) * u(i, j, k) * cell_volume;
+                }
+    }
+    return energy;
+}
+
+}  // namespace meniscus::coupling

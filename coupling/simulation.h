@@ -1,0 +1,80 @@
+#pragma once
+/// \file One coupled step of liquid/gas flow with an explicit interface (DESIGN.md coupling):
+/// (1) Δt from CFL, the capillary limit (with the smaller of Δx and the mesh's mean edge
+/// length) and the time left to the frame; (2) mesh → φ at cell centres and κ at crossed faces;
+/// (3) the fluid step; (4) grid velocity → mesh vertices; (5) the tracker's improve(),
+/// change_topology() and collision-safe integrate(); (6) optional volume correction per
+/// connected component (through merges and pinch-offs).
+
+#include "coupling/interpolate.h"
+#include "coupling/rasterize.h"
+#include "coupling/surface_tension.h"
+#include "coupling/volume_correction.h"
+#include "fluid/fluid_solver.h"
+#include "tracker/surface_tracker.h"
+
+#include <memory>
+#include <string>
+
+namespace meniscus::coupling {
+
+/// Options of the coupled step. Defaults here and nowhere else.
+struct SimulationOptions {
+    RasterizeOptions rasterize;
+    SurfaceTensionOptions surface_tension;
+    InterpolateOptions interpolate;
+    bool volume_correction = true;  ///< restore each component's volume every step
+    /// Safety factor on the capillary limit sqrt(ρ̄ h³ / (2πσ)), h = min(Δx, mean edge), in (0, 1].
+    double capillary_safety = 1.0;
+    void validate() const;  ///< throws std::invalid_argument naming the field
+};
+
+/// Which limit set a step's Δt.
+enum class StepLimit { cfl, capillary, frame_end, max_dt };
+const char* to_string(StepLimit limit);
+
+/// What one coupled step did. Seconds are wall clock per phase.
+struct SimulationStepReport {
+    double dt = 0.0;
+    StepLimit limit = StepLimit::max_dt;
+    fluid::StepResult fluid;
+    tracker::IntegrateResult integrate;
+    tracker::ImproveReport improve;
+    tracker::TopologyReport topology;
+    VolumeReport volume;
+    double max_vertex_speed = 0.0;  ///< m/s, interpolated
+    double rasterize_seconds = 0.0;
+    double fluid_seconds = 0.0;
+    double interpolate_seconds = 0.0;
+    double tracker_seconds = 0.0;
+};
+
+/// Owns the tracker and the fluid solver and steps them together.
+class Simulation {
+public:
+    /// Throws std::invalid_argument on bad options.
+    Simulation(tracker::SurfaceTracker tracker, fluid::FluidSolver fluid,
+               const SimulationOptions& options);
+
+    /// Advances by one step of at most `max_dt` (s), e.g. the time left to the next frame.
+    SimulationStepReport step(double max_dt);
+
+    const tracker::SurfaceTracker& tracker() const { return *m_tracker; }
+    const fluid::FluidSolver& fluid() const { return m_fluid; }
+    double time() const { return m_time; }
+    /// Per-vertex velocities of the last step (sized mesh().num_vertices()), m/s.
+    const std::vector<tracker::Vec3>& vertex_velocities() const { return m_vertex_velocities; }
+    /// Kinetic energy ½ Σ ρ u² dV over the grid's faces (J), liquid and gas by φ.
+    double kinetic_energy() const;
+
+private:
+    std::unique_ptr<tracker::SurfaceTracker> m_tracker;  // stable address for the observer
+    fluid::FluidSolver m_fluid;
+    SimulationOptions m_options;
+    std::unique_ptr<VolumeTracker> m_volumes;
+    std::vector<tracker::Vec3> m_vertex_velocities;
+    fluid::Array3<double> m_phi;  ///< φ of the last step, for the kinetic energy
+    double m_time = 0.0;
+};
+
+}  // namespace meniscus::coupling

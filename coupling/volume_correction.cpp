@@ -1,0 +1,160 @@
+#include "coupling/volume_correction.h"
+
+#include "tracker/mesh_measures.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+namespace meniscus::coupling {
+
+using tracker::INVALID_INDEX;
+using tracker::Vec3;
+
+namespace {
+
+/// Component of each vertex (first triangle's component; −1 for vertices without triangles).
+std::vector<int> vertex_components(const tracker::SurfaceMesh& mesh, const tracker::Components& c) {
+    std::vector<int> out(static_cast<size_t>(mesh.num_vertices()), -1);
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty())
+            continue;
+        out[static_cast<size_t>(vi)] =
+            c.triangle_component[static_cast<size_t>(mesh.vertex_triangles(vi).front())];
+    }
+    return out;
+}
+
+}  // namespace
+
+VolumeTracker::VolumeTracker(tracker::SurfaceMesh& mesh) : m_mesh(mesh) {
+    const tracker::Components c = tracker::triangle_components(mesh);
+    m_targets = tracker::component_volumes(mesh, c);
+    m_triangle_component = c.triangle_component;
+    m_mesh.add_observer(this);
+}
+
+VolumeTracker::~VolumeTracker() {
+    m_mesh.remove_observer(this);
+}
+
+void VolumeTracker::begin_step() {
+    const tracker::Components c = tracker::triangle_components(m_mesh);
+    m_vertex_component = vertex_components(m_mesh, c);
+    m_old_targets = m_targets;
+    if (static_cast<int>(m_old_targets.size()) != c.count) {
+        // The mesh changed outside a step (should not happen): start over from its volumes.
+        m_old_targets = tracker::component_volumes(m_mesh, c);
+    }
+}
+
+void VolumeTracker::on_compact(const std::vector<int>& old_to_new_vertex) {
+    if (m_vertex_component.empty())
+        return;
+    std::vector<int> moved(static_cast<size_t>(m_mesh.num_vertices()), -1);
+    for (size_t old = 0; old < old_to_new_vertex.size() && old < m_vertex_component.size(); ++old) {
+        const int nv = old_to_new_vertex[old];
+        if (nv >= 0 && static_cast<size_t>(nv) < moved.size())
+            moved[static_cast<size_t>(nv)] = m_vertex_component[old];
+    }
+    m_vertex_component = std::move(moved);
+}
+
+VolumeReport VolumeTracker::match_components() {
+    const tracker::Components c = tracker::triangle_components(m_mesh);
+    m_triangle_component = c.triangle_component;
+    VolumeReport report;
+    report.volumes = tracker::component_volumes(m_mesh, c);
+    const std::vector<int> now = vertex_components(m_mesh, c);
+    // Old components feeding each new one, and new ones fed by each old one.
+    std::vector<std::set<int>> sources(static_cast<size_t>(c.count));
+    std::map<int, std::set<int>> fed;
+    for (size_t vi = 0; vi < now.size() && vi < m_vertex_component.size(); ++vi) {
+        const int old_c = m_vertex_component[vi], new_c = now[vi];
+        if (old_c < 0 || new_c < 0 || static_cast<size_t>(old_c) >= m_old_targets.size())
+            continue;
+        sources[static_cast<size_t>(new_c)].insert(old_c);
+        fed[old_c].insert(new_c);
+    }
+    report.targets.assign(static_cast<size_t>(c.count), 0.0);
+    for (int nc = 0; nc < c.count; ++nc) {
+        const auto& src = sources[static_cast<size_t>(nc)];
+        if (src.empty()) {
+            report.targets[static_cast<size_t>(nc)] = report.volumes[static_cast<size_t>(nc)];
+            continue;
+        }
+        if (src.size() > 1)
+            ++report.merges;
+        for (int oc : src) {
+            // Share old component oc's target among the new components it feeds, by volume.
+            const auto& outs = fed[oc];
+            double total = 0.0;
+            for (int o : outs)
+                total += std::abs(report.volumes[static_cast<size_t>(o)]);
+            const double share = total > 0.0
+                                     ? std::abs(report.volumes[static_cast<size_t>(nc)]) / total
+                                     : 1.0 / static_cast<double>(outs.size());
+            report.targets[static_cast<size_t>(nc)] +=
+                share * m_old_targets[static_cast<size_t>(oc)];
+        }
+    }
+    for (const auto& [oc, outs] : fed)
+        if (outs.size() > 1)
+            ++report.splits;
+    for (int nc = 0; nc < c.count; ++nc) {
+        const double target = report.targets[static_cast<size_t>(nc)];
+        if (target != 0.0)
+            report.max_relative_error = std::max(
+                report.max_relative_error,
+                std::abs(report.volumes[static_cast<size_t>(nc)] - target) / std::abs(target));
+    }
+    m_targets = report.targets;
+    m_vertex_component.clear();
+    return report;
+}
+
+double VolumeTracker::add_correction(std::vector<Vec3>& velocities, double dt) const {
+    if (!(dt > 0.0))
+        throw std::invalid_argument("add_correction: dt must be > 0");
+    if (velocities.size() != static_cast<size_t>(m_mesh.num_vertices()))
+        throw std::invalid_argument("add_correction: velocities must be sized num_vertices()");
+    const size_t nc = m_targets.size();
+    std::vector<double> volume(nc, 0.0), area(nc, 0.0);
+    std::vector<Vec3> normal(static_cast<size_t>(m_mesh.num_vertices()), Vec3::Zero());
+    tracker::Components c;
+    c.count = static_cast<int>(nc);
+    c.triangle_component = m_triangle_component;
+    if (c.triangle_component.size() != static_cast<size_t>(m_mesh.num_triangles()))
+        throw std::logic_error("add_correction: call match_components() after the mesh changes");
+    volume = tracker::component_volumes(m_mesh, c);
+    for (int ti = 0; ti < m_mesh.num_triangles(); ++ti) {
+        if (!m_mesh.triangle_alive(ti))
+            continue;
+        const tracker::Triangle& t = m_mesh.triangle(ti);
+        const Vec3 n2 = (m_mesh.position(t[1]) - m_mesh.position(t[0]))
+                            .cross(m_mesh.position(t[2]) - m_mesh.position(t[0]));
+        area[static_cast<size_t>(c.triangle_component[static_cast<size_t>(ti)])] += 0.5 * n2.norm();
+        for (int v : t)
+            normal[static_cast<size_t>(v)] += n2;  // area-weighted
+    }
+    double largest = 0.0;
+    for (int vi = 0; vi < m_mesh.num_vertices(); ++vi) {
+        if (!m_mesh.vertex_alive(vi) || m_mesh.vertex_triangles(vi).empty())
+            continue;
+        const int comp =
+            c.triangle_component[static_cast<size_t>(m_mesh.vertex_triangles(vi).front())];
+        const double a = area[static_cast<size_t>(comp)];
+        const double n = normal[static_cast<size_t>(vi)].norm();
+        if (!(a > 0.0) || !(n > 0.0))
+            continue;
+        const double offset =
+            (m_targets[static_cast<size_t>(comp)] - volume[static_cast<size_t>(comp)]) / a;
+        velocities[static_cast<size_t>(vi)] += (offset / dt) * normal[static_cast<size_t>(vi)] / n;
+        largest = std::max(largest, std::abs(offset));
+    }
+    return largest;
+}
+
+}  // namespace meniscus::coupling
