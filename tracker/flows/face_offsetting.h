@@ -17,15 +17,16 @@
 /// convex crease moving inward) the vertex lands on the planes' intersection: the entropy
 /// solution that vertex-normal motion misses. Where they diverge (an expansion fan: convex
 /// moving outward, concave moving inward) the planes' intersection would keep the crease sharp
-/// and overshoot the exact, rounded fan by h (1/cos θ − 1) per unit of travel, without
-/// converging under refinement. With `ExpansionRule::huygens` (default) such vertices instead
-/// move by the mean offset h̄ along the mean normal m = Σ wᵢ nᵢ / |Σ wᵢ nᵢ| (Huygens'
-/// principle: the exact fan point at distance h from the crease, for any m in the normal cone);
-/// remeshing then fills the widening fan. The decision follows the vertex's sharpest incident
-/// edge (largest dihedral angle): the vertex is expanding when that edge is convex and the
-/// motion outward (h̄ > 0), or concave and inward. Deciding by the sharpest edge rather than by
-/// the mean curvature keeps a concave crease on a saddle (the neck right after two spheres
-/// merge, convex around the neck) a shock. On smooth patches both rules agree to O(h θ²).
+/// and overshoot the exact, rounded fan by (1/cos θ − 1) times the distance travelled (2θ the
+/// angle between the crease's normals), without converging under refinement. With
+/// `ExpansionRule::huygens` (default) such vertices instead move by the mean offset h̄ along the
+/// mean normal m = Σ wᵢ nᵢ / |Σ wᵢ nᵢ| (Huygens' principle: the exact fan point at distance h from
+/// the crease, for any m in the normal cone); remeshing then fills the widening fan. The decision
+/// follows the vertex's sharpest incident edge (largest dihedral angle): the vertex is expanding
+/// when that edge is convex and the motion outward (h̄ > 0), or concave and inward. Deciding by the
+/// sharpest edge rather than by the mean curvature keeps a concave crease on a saddle (the neck
+/// right after two spheres merge, convex around the neck) a shock. On smooth patches both rules
+/// agree to O(h θ²).
 ///
 /// Weights wᵢ: triangle areas (default) or the triangle's interior angle at the vertex.
 ///
