@@ -40,10 +40,11 @@ const char* USAGE =
     "        stats.jsonl into DIR (default: out/). --frames N overrides the scene's frame count\n"
     "        (keeping its time per frame). Ctrl-C stops after the current step; every file\n"
     "        already written is complete.\n"
-    "  validate [--quick|--full] [--out DIR]\n"
+    "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4]...\n"
     "        run the paper's geometric-flow validation cases (quick: coarse, minutes; full: the\n"
     "        paper's resolutions, hours) and write report.md, results.json and plots into DIR\n"
-    "        (default: validation/); exit code 1 if a run failed or intersected\n"
+    "        (default: validation/); --case runs only the named cases (repeatable); exit code 1\n"
+    "        if a run failed or intersected\n"
     "  scene-reference\n"
     "        print every scene key with its type, default, unit and meaning (Markdown)\n"
     "\n"
@@ -134,7 +135,12 @@ int dispatch(int argc, char** argv) {
                 options.full = true;
             else if (args[i] == "--out" && i + 1 < args.size())
                 options.out_dir = args[++i];
-            else
+            else if (args[i] == "--case" && i + 1 < args.size()) {
+                const std::string id = args[++i];
+                if (id != "A1" && id != "A2" && id != "A3" && id != "A4")
+                    throw UsageError("validate: --case expects A1, A2, A3 or A4, got '" + id + "'");
+                options.cases.push_back(id);
+            } else
                 throw UsageError("validate: unknown or incomplete option " + args[i]);
         }
         return run_validation(options);

@@ -619,7 +619,7 @@ void report_a2(std::ostringstream& md, const Json& results) {
     md << "\n### Dumbbell\n\n";
     const std::vector<Json> db = select(results["runs"], "A2", "dumbbell");
     if (db.empty()) {
-        md << "Not run in this mode (`--full` runs it).\n\n";
+        md << "Not run (quick mode runs it only with `--full`, or it was left out by `--case`).\n\n";
         return;
     }
     md << "Our dumbbell: bulbs r = " << fmt(DUMBBELL_BULB_RADIUS) << " at ±"
@@ -674,7 +674,7 @@ void report_a4(std::ostringstream& md, const Json& results) {
         select(results["runs"], "A4", "curl noise, collision safety off");
     rs.insert(rs.end(), unsafe.begin(), unsafe.end());
     if (rs.empty()) {
-        md << "Not run in this mode (`--full` runs it).\n\n";
+        md << "Not run (quick mode runs it only with `--full`, or it was left out by `--case`).\n\n";
         return;
     }
     md << "Planar curl noise (ψ = (0, 0, φ)), RMS speed " << fmt(CURL_RMS_SPEED) << " m/s, base "
@@ -788,10 +788,22 @@ int run_validation(const ValidateOptions& options) {
     if (!options.quiet)
         std::fprintf(stderr, "meniscus validate (%s) → %s\n", options.full ? "full" : "quick",
                      out.string().c_str());
-    case_a1(c);
-    case_a2(c);
-    case_a3(c);
-    case_a4(c);
+    const auto wanted = [&](const char* id) {
+        return options.cases.empty() ||
+               std::find(options.cases.begin(), options.cases.end(), id) != options.cases.end();
+    };
+    for (const std::string& id : options.cases)
+        if (id != "A1" && id != "A2" && id != "A3" && id != "A4")
+            throw std::invalid_argument("validate: unknown case '" + id +
+                                        "' (expected A1, A2, A3 or A4)");
+    if (wanted("A1"))
+        case_a1(c);
+    if (wanted("A2"))
+        case_a2(c);
+    if (wanted("A3"))
+        case_a3(c);
+    if (wanted("A4"))
+        case_a4(c);
 
     Json results;
     results["mode"] = options.full ? "full" : "quick";

@@ -7,6 +7,7 @@
 /// `plot_validation.py` (written beside them; needs /usr/bin/python3 with matplotlib).
 
 #include <string>
+#include <vector>
 
 namespace meniscus::app {
 
@@ -17,6 +18,8 @@ struct ValidateOptions {
     bool full = false;
     std::string out_dir = "validation";  ///< folder for report.md, results.json and plots
     bool quiet = false;                  ///< no progress lines on stderr
+    /// Cases to run ("A1", "A2", "A3", "A4"; A5 is timed on the A1 runs); empty: all.
+    std::vector<std::string> cases;
 };
 
 /// Runs the validation cases and writes the report. Returns a process exit code: 0 when every
