@@ -35,10 +35,11 @@ const char* USAGE =
     "usage: meniscus <command> [options]\n"
     "\n"
     "commands:\n"
-    "  run SCENE.json [--out DIR] [--frames N] [--quiet]\n"
+    "  run SCENE.json [--out DIR] [--frames N] [--max-steps N] [--quiet]\n"
     "        run a scene, writing per frame surface_NNNN.ply, fields_NNNN.vdb and a line of\n"
     "        stats.jsonl into DIR (default: out/). --frames N overrides the scene's frame count\n"
-    "        (keeping its time per frame). Ctrl-C stops after the current step; every file\n"
+    "        (keeping its time per frame); --max-steps N stops after N time steps (smoke tests).\n"
+    "        Ctrl-C stops after the current step; every file\n"
     "        already written is complete.\n"
     "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4]...\n"
     "        run the paper's geometric-flow validation cases (quick: coarse, minutes; full: the\n"
@@ -85,6 +86,8 @@ int command_run(const std::vector<std::string>& args) {
             options.out_dir = value();
         else if (a == "--frames")
             options.frames = parse_positive_int(a, value());
+        else if (a == "--max-steps")
+            options.max_steps = parse_positive_int(a, value());
         else if (a == "--quiet")
             options.quiet = true;
         else if (!a.empty() && a[0] == '-')

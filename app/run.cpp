@@ -1,6 +1,7 @@
 #include "app/run.h"
 
 #include "app/progress.h"
+#include "coupling/simulation.h"
 #include "coupling/vdb_output.h"
 #include "tracker/flows/velocity_field.h"
 #include "tracker/implicit_mesher.h"
@@ -44,6 +45,7 @@ std::string frame_path(const std::string& dir, const char* stem, int frame, cons
 }
 
 std::unique_ptr<tracker::VelocityField> make_field(const FlowOptions& flow) {
+    // "fluid" scenes never get here (run_fluid_scene).
     if (flow.type == "enright")
         return std::make_unique<tracker::EnrightField>(flow.period);
     return nullptr;  // "none": the surface stays where it is
@@ -75,7 +77,8 @@ public:
     }
 
     /// Writes the frame's files; returns seconds spent.
-    double write(int frame, const SurfaceMesh& mesh, const std::vector<Vec3>& velocities) {
+    double write(int frame, const SurfaceMesh& mesh, const std::vector<Vec3>& velocities,
+                 const coupling::FluidFields& fluid = {}) {
         const auto start = Clock::now();
         const OutputOptions& o = m_scene.output;
         if (o.ply)
@@ -148,7 +151,8 @@ void check_intersection_free(const SurfaceMesh& mesh, const std::string& what) {
 
 }  // namespace
 
-SurfaceMesh build_initial_surface(const Scene& scene, std::string* report) {
+/// The initial surface's geometry and connectivity (labels still the default: liquid inside).
+static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::string* report) {
     if (scene.shape) {
         tracker::ImplicitMeshOptions options;
         options.edge_length = scene.surface.edge_length;
@@ -200,7 +204,161 @@ SurfaceMesh build_initial_surface(const Scene& scene, std::string* report) {
     return mesh;
 }
 
+SurfaceMesh build_initial_surface(const Scene& scene, std::string* report) {
+    SurfaceMesh mesh = build_initial_surface_geometry(scene, report);
+    // /surface/inside: which phase the surface encloses.
+    const tracker::LabelPair labels =
+        scene.surface.inside == "gas" ? tracker::LabelPair{0, 1} : tracker::LabelPair{1, 0};
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        if (mesh.triangle_alive(ti))
+            mesh.set_labels(ti, labels);
+    return mesh;
+}
+
+/// Sets every face whose centre lies inside a region's shape to that region's velocity.
+void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::MacGrid& grid) {
+    for (int axis = 0; axis < 3; ++axis) {
+        fluid::Array3<double>& u = grid.velocity(axis);
+        for (int k = 0; k < u.nk(); ++k)
+            for (int j = 0; j < u.nj(); ++j)
+                for (int i = 0; i < u.ni(); ++i) {
+                    const Vec3 x = grid.face_centre(axis, i, j, k);
+                    for (const VelocityRegion& r : regions)
+                        if (r.shape->value(x) < 0.0)
+                            u(i, j, k) = r.velocity[axis];
+                }
+    }
+}
+
+nlohmann::json fluid_frame_stats(int frame, double time, long long steps,
+                                 const coupling::Simulation& sim,
+                                 const coupling::SimulationStepReport& last,
+                                 const nlohmann::json& seconds, const nlohmann::json& work) {
+    const SurfaceMesh& mesh = sim.tracker().mesh();
+    const auto components = tracker::triangle_components(mesh);
+    const auto volumes = tracker::component_volumes(mesh, components);
+    double total = 0.0, max_speed = 0.0;
+    for (double v : volumes)
+        total += v;
+    const fluid::MacGrid& grid = sim.fluid().grid();
+    for (int axis = 0; axis < 3; ++axis) {
+        const fluid::Array3<double>& u = grid.velocity(axis);
+        for (int k = 0; k < u.nk(); ++k)
+            for (int j = 0; j < u.nj(); ++j)
+                for (int i = 0; i < u.ni(); ++i)
+                    max_speed = std::max(max_speed, std::abs(u(i, j, k)));
+    }
+    nlohmann::json line = {{"frame", frame},
+                           {"time", time},
+                           {"dt", last.dt},
+                           {"dt_limit", coupling::to_string(last.limit)},
+                           {"steps", steps},
+                           {"vertices", mesh.count_live_vertices()},
+                           {"triangles", mesh.count_live_triangles()},
+                           {"components", components.count},
+                           {"volume", total},
+                           {"component_volumes", volumes},
+                           {"volume_targets", last.volume.targets},
+                           {"kinetic_energy", sim.kinetic_energy()},
+                           {"max_speed", max_speed},
+                           {"pressure_iterations", last.fluid.pressure.iterations},
+                           {"pressure_converged", last.fluid.pressure.converged},
+                           {"seconds", seconds}};
+    line.update(work);
+    return line;
+}
+
+RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
+                          const std::atomic<bool>& stop) {
+    std::string report;
+    SurfaceMesh initial = build_initial_surface(scene, &report);
+    const double dx = scene.domain.size.x() / scene.domain.cells;
+    const auto cells_along = [&](double size) {
+        return std::max(1, static_cast<int>(std::lround(size / dx)));
+    };
+    fluid::FluidSolver solver(scene.domain.cells, cells_along(scene.domain.size.y()),
+                              cells_along(scene.domain.size.z()), dx, scene.domain.min,
+                              scene.fluid);
+    apply_initial_velocity(scene.initial_velocity, solver.grid());
+    coupling::Simulation sim(tracker::SurfaceTracker(std::move(initial), scene.tracker),
+                             std::move(solver), scene.coupling.simulation);
+    if (!options.quiet)
+        std::fprintf(stderr, "%s: %s; fluid grid %d x %d x %d, dx = %g m\n", scene.name.c_str(),
+                     report.c_str(), sim.fluid().grid().nx(), sim.fluid().grid().ny(),
+                     sim.fluid().grid().nz(), dx);
+
+    const int frames = options.frames > 0 ? options.frames : scene.time.frames;
+    const double frame_dt = scene.time.end / scene.time.frames;
+    const double end_time = frame_dt * frames;
+    FrameWriter writer(scene, options.out_dir);
+    Progress progress(stderr, options.quiet);
+    const auto fields = [&]() {
+        return coupling::FluidFields{&sim.fluid().grid(), &sim.fluid().pressure()};
+    };
+
+    RunResult result;
+    coupling::SimulationStepReport last;
+    double output_seconds =
+        writer.write(0, sim.tracker().mesh(), sim.vertex_velocities(), fields());
+    writer.stats(fluid_frame_stats(0, 0.0, 0, sim, last, {{"output", output_seconds}},
+                                   nlohmann::json::object()));
+    result.frames_written = 1;
+    double t = 0.0;
+    for (int frame = 1; frame <= frames; ++frame) {
+        const double t_frame = frame == frames ? end_time : frame * frame_dt;
+        long long steps = 0;
+        double rasterize = 0.0, fluid_s = 0.0, interpolate = 0.0, tracker_s = 0.0;
+        long long intersecting = -1, merges = 0, splits = 0, shortenings = 0;
+        while (t < t_frame) {
+            if (stop.load() || (options.max_steps > 0 && result.steps >= options.max_steps)) {
+                progress.finish();
+                result.interrupted = stop.load();
+                result.reached_max_steps = !result.interrupted;
+                result.simulated_time = t;
+                return result;
+            }
+            last = sim.step(t_frame - t);
+            rasterize += last.rasterize_seconds;
+            fluid_s += last.fluid_seconds;
+            interpolate += last.interpolate_seconds;
+            tracker_s += last.tracker_seconds;
+            intersecting = std::max<long long>(intersecting, last.integrate.intersecting_pairs);
+            result.max_intersecting_pairs =
+                std::max(result.max_intersecting_pairs, last.integrate.intersecting_pairs);
+            merges += last.volume.merges;
+            splits += last.volume.splits;
+            shortenings += last.integrate.collisions.step_shortenings;
+            t = (t_frame - (t + last.dt) <= 1e-12 * t_frame) ? t_frame : t + last.dt;
+            ++steps;
+            ++result.steps;
+        }
+        output_seconds =
+            writer.write(frame, sim.tracker().mesh(), sim.vertex_velocities(), fields());
+        writer.stats(fluid_frame_stats(frame, t, steps, sim, last,
+                                       {{"rasterize", rasterize},
+                                        {"fluid", fluid_s},
+                                        {"interpolate", interpolate},
+                                        {"tracker", tracker_s},
+                                        {"output", output_seconds}},
+                                       {{"intersecting_pairs", intersecting},
+                                        {"merges", merges},
+                                        {"splits", splits},
+                                        {"step_shortenings", shortenings}}));
+        result.frames_written = frame + 1;
+        result.simulated_time = t;
+        char detail[128];
+        std::snprintf(detail, sizeof detail, "%d triangles, %d components, %lld steps",
+                      sim.tracker().mesh().count_live_triangles(),
+                      tracker::triangle_components(sim.tracker().mesh()).count, steps);
+        progress.frame_done(frame, frames, t, detail);
+    }
+    progress.finish();
+    return result;
+}
+
 RunResult run_scene(const Scene& scene, const RunOptions& options, const std::atomic<bool>& stop) {
+    if (scene.flow.type == "fluid")
+        return run_fluid_scene(scene, options, stop);
     std::string report;
     tracker::SurfaceTracker tracker(build_initial_surface(scene, &report), scene.tracker);
     const SurfaceMesh& mesh = tracker.mesh();
@@ -229,9 +387,10 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
         long long steps = 0;
         work = FrameWork{};
         while (t < t_frame) {
-            if (stop.load()) {
+            if (stop.load() || (options.max_steps > 0 && result.steps >= options.max_steps)) {
                 progress.finish();
-                result.interrupted = true;
+                result.interrupted = stop.load();
+                result.reached_max_steps = !result.interrupted;
                 result.simulated_time = t;
                 return result;
             }
@@ -257,6 +416,8 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
             work.impact_zone_iterations += r.collisions.impact_zone_iterations;
             work.step_shortenings += r.collisions.step_shortenings;
             work.intersecting_pairs = std::max(work.intersecting_pairs, r.intersecting_pairs);
+            result.max_intersecting_pairs =
+                std::max(result.max_intersecting_pairs, r.intersecting_pairs);
             // Land exactly on the frame time despite round-off in the sum of steps.
             t = (t_frame - (t + dt) <= 1e-12 * t_frame) ? t_frame : t + dt;
             ++steps;

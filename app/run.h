@@ -19,7 +19,8 @@ public:
 /// Command-line choices of `meniscus run`.
 struct RunOptions {
     std::string out_dir = "out";
-    int frames = 0;  ///< > 0 overrides /time/frames, keeping the time per frame
+    int frames = 0;           ///< > 0 overrides /time/frames, keeping the time per frame
+    long long max_steps = 0;  ///< > 0 stops after this many steps (smoke tests)
     bool quiet = false;
 };
 
@@ -27,6 +28,10 @@ struct RunOptions {
 struct RunResult {
     int frames_written = 0;  ///< including frame 0
     bool interrupted = false;
+    bool reached_max_steps = false;  ///< stopped by RunOptions::max_steps
+    /// Worst exact self-intersection count over all steps (−1 unless
+    /// /tracker/verify_intersection_free is on).
+    int max_intersecting_pairs = -1;
     double simulated_time = 0.0;
     long long steps = 0;
 };

@@ -12,7 +12,93 @@ namespace {
 using tracker::ShapePtr;
 using Vec3 = Eigen::Vector3d;
 
-const std::vector<std::string> FLOW_TYPES = {"enright", "none"};
+const std::vector<std::string> FLOW_TYPES = {"fluid", "enright", "none"};
+
+/// Reads/describes an enum through its names (the first name is used for the reference).
+template <typename V, typename Enum>
+void enum_field(V& v, const char* key, Enum& value,
+                const std::vector<std::pair<std::string, Enum>>& names, const char* meaning) {
+    std::string text;
+    std::vector<std::string> allowed;
+    for (const auto& [name, e] : names) {
+        allowed.push_back(name);
+        if (e == value)
+            text = name;
+    }
+    v.choice(key, text, allowed, meaning);
+    for (const auto& [name, e] : names)
+        if (name == text)
+            value = e;
+}
+
+const std::vector<std::pair<std::string, fluid::WallType>> WALL_TYPES = {
+    {"free_slip", fluid::WallType::free_slip}, {"no_slip", fluid::WallType::no_slip}};
+
+template <typename V>
+void visit_fields(V& v, DomainOptions& o) {
+    v.vec3("min", o.min, Range::any(), "m", "min corner of the fluid box");
+    v.vec3("size", o.size, Range::positive(), "m", "edge lengths of the fluid box");
+    v.integer("cells", o.cells, Range::between(2, 4096), "",
+              "cells along x (cubic cells; y and z get size/dx rounded)");
+}
+
+template <typename V>
+void visit_fields(V& v, fluid::FluidOptions& o) {
+    enum_field(v, "mode", o.mode,
+               {{"two_phase", fluid::FluidMode::two_phase},
+                {"free_surface", fluid::FluidMode::free_surface}},
+               "`two_phase` solves liquid and gas; `free_surface` treats the gas as void");
+    v.vec3("gravity", o.gravity, Range::any(), "m/s²", "body acceleration");
+    v.section("phases", "densities, viscosities, surface tension", [&](auto& r) {
+        r.number("rho_liquid", o.phases.rho_liquid, Range::positive(), "kg/m³", "liquid density");
+        r.number("rho_gas", o.phases.rho_gas, Range::positive(), "kg/m³", "gas density");
+        r.number("mu_liquid", o.phases.mu_liquid, Range::non_negative(), "Pa·s",
+                 "liquid viscosity");
+        r.number("mu_gas", o.phases.mu_gas, Range::non_negative(), "Pa·s", "gas viscosity");
+        r.number("sigma", o.phases.sigma, Range::non_negative(), "N/m",
+                 "surface tension coefficient");
+    });
+    v.section("walls", "boundary condition of each box wall", [&](auto& r) {
+        enum_field(r, "x_min", o.walls.x_min, WALL_TYPES, "wall at min x");
+        enum_field(r, "x_max", o.walls.x_max, WALL_TYPES, "wall at max x");
+        enum_field(r, "y_min", o.walls.y_min, WALL_TYPES, "wall at min y");
+        enum_field(r, "y_max", o.walls.y_max, WALL_TYPES, "wall at max y");
+        enum_field(r, "z_min", o.walls.z_min, WALL_TYPES, "wall at min z");
+        enum_field(r, "z_max", o.walls.z_max, WALL_TYPES, "wall at max z");
+    });
+    enum_field(v, "advection", o.advection.scheme,
+               {{"maccormack", fluid::AdvectionScheme::maccormack},
+                {"bfecc", fluid::AdvectionScheme::bfecc},
+                {"semi_lagrangian", fluid::AdvectionScheme::semi_lagrangian}},
+               "velocity advection scheme");
+    v.boolean("viscosity", o.viscosity.enabled, "implicit viscosity on/off");
+    enum_field(v, "pressure_solver", o.pressure.solver,
+               {{"multigrid_pcg", fluid::PressureSolver::multigrid_pcg},
+                {"mic0_pcg", fluid::PressureSolver::mic0_pcg},
+                {"eigen_ic_cg", fluid::PressureSolver::eigen_ic_cg}},
+               "pressure Poisson solver");
+    v.number("pressure_tolerance", o.pressure.iteration.tolerance, Range{0.0, 1.0, true, true}, "",
+             "relative residual of the pressure solve");
+    v.number("cfl_number", o.time_step.cfl_number, Range::positive(), "cells",
+             "cells a fluid particle may cross per step");
+    v.number("max_dt", o.time_step.max_dt, Range::positive(), "s", "upper bound on the time step");
+}
+
+template <typename V>
+void visit_fields(V& v, CouplingOptions& o) {
+    v.number("edge_length_cells", o.edge_length_cells, Range::non_negative(), "cells",
+             "tracker edge length in grid cells (0 = use /surface/edge_length)");
+    v.boolean("volume_correction", o.simulation.volume_correction,
+              "restore each connected component's volume every step (followed through merges)");
+    v.integer("curvature_smoothing", o.simulation.surface_tension.smoothing_passes,
+              Range::between(0, 20), "", "one-ring averaging passes over vertex curvature");
+    enum_field(v, "velocity_interpolation", o.simulation.interpolate.method,
+               {{"trilinear", coupling::VelocityInterpolation::trilinear},
+                {"quadratic_bspline", coupling::VelocityInterpolation::quadratic_bspline}},
+               "grid → vertex velocity reconstruction");
+    v.number("capillary_safety", o.simulation.capillary_safety, Range{0.0, 1.0, true, false}, "",
+             "factor on the capillary time-step limit");
+}
 
 template <typename V>
 void visit_fields(V& v, SurfaceOptions& o) {
@@ -23,12 +109,16 @@ void visit_fields(V& v, SurfaceOptions& o) {
            "closed, consistently oriented, no degenerate or duplicate triangles");
     v.integer("remesh_iterations", o.remesh_iterations, Range::between(0, 100), "",
               "isotropic remeshing passes after marching tetrahedra");
+    v.choice("inside", o.inside, {"liquid", "gas"},
+             "phase enclosed by the surface: `liquid` (drops, pools) or `gas` (bubbles; the "
+             "liquid fills everything outside)");
 }
 
 template <typename V>
 void visit_fields(V& v, FlowOptions& o) {
     v.choice("type", o.type, FLOW_TYPES,
-             "velocity field: `enright` (paper §4.3 deformation test, RK4), `none`");
+             "what moves the surface: `fluid` (coupled Navier–Stokes), `enright` (paper §4.3 "
+             "deformation test, RK4), `none`");
     v.number("period", o.period, Range::positive(), "s",
              "Enright period T; the field is modulated by sin(2πt/T)");
 }
@@ -151,6 +241,13 @@ void visit_fields(V& v, Scene& s) {
               [&](auto& r) { visit_fields(r, s.tracker); });
     v.section("flow", "the velocity field that moves the surface",
               [&](auto& r) { visit_fields(r, s.flow); });
+    v.section("domain", "the fluid box (fluid scenes)",
+              [&](auto& r) { visit_fields(r, s.domain); });
+    v.section("fluid", "the Navier–Stokes solver (fluid scenes)",
+              [&](auto& r) { visit_fields(r, s.fluid); });
+    v.section("coupling", "mesh ↔ grid coupling (fluid scenes)",
+              [&](auto& r) { visit_fields(r, s.coupling); });
+    v.known("initial_velocity");  // array of {shape, velocity}, parsed by parse_velocity_regions()
     v.section("time", "simulated time and frames", [&](auto& r) { visit_fields(r, s.time); });
     v.section("output", "per-frame files", [&](auto& r) { visit_fields(r, s.output); });
 }
@@ -316,6 +413,26 @@ ShapePtr parse_shape(const nlohmann::json& j, const std::string& path) {
     }
 }
 
+std::vector<VelocityRegion> parse_velocity_regions(const nlohmann::json& j) {
+    const std::string path = "/initial_velocity";
+    if (!j.is_array())
+        throw SceneError(path + ": expected an array of {shape, velocity}");
+    std::vector<VelocityRegion> regions;
+    for (size_t i = 0; i < j.size(); ++i) {
+        const std::string item = path + "/" + std::to_string(i);
+        JsonReader r(j[i], item);
+        VelocityRegion region;
+        r.vec3("velocity", region.velocity, Range::any(), "m/s", "");
+        r.known("shape");
+        if (!r.has("shape"))
+            r.fail("shape", "required: the region's shape");
+        region.shape = parse_shape(r.raw("shape"), item + "/shape");
+        r.finish();
+        regions.push_back(std::move(region));
+    }
+    return regions;
+}
+
 std::string read_file(const std::string& path) {
     std::ifstream in(path);
     if (!in)
@@ -343,7 +460,17 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
         // /surface/shape is a tree, parsed separately.
         if (j.contains("surface") && j["surface"].is_object() && j["surface"].contains("shape"))
             scene.shape = parse_shape(j["surface"]["shape"], "/surface/shape");
+        if (j.contains("initial_velocity"))
+            scene.initial_velocity = parse_velocity_regions(j["initial_velocity"]);
         root.finish();
+        try {
+            scene.fluid.validate();
+        } catch (const std::invalid_argument& e) {
+            throw SceneError(std::string("/fluid/") + e.what());
+        }
+        if (scene.flow.type == "fluid" && scene.coupling.edge_length_cells > 0.0)
+            scene.surface.edge_length =
+                scene.coupling.edge_length_cells * scene.domain.size.x() / scene.domain.cells;
         try {
             scene.tracker.validate();
         } catch (const std::invalid_argument& e) {
@@ -400,6 +527,15 @@ std::string scene_reference_markdown() {
         visit_fields(s5, tp);
         ReferenceWriter s6(tables, "/surface/shape (type dumbbell)", "");
         visit_fields(s6, dp);
+    }
+    {
+        ReferenceWriter velocity(
+            tables, "/initial_velocity",
+            "Array of regions; every velocity face whose centre is inside "
+            "`shape` starts with that component of `velocity` (later regions win).");
+        velocity.add({"shape", "shape", "(required)", "", "a shape as in /surface/shape"});
+        Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+        velocity.vec3("velocity", zero, Range::any(), "m/s", "initial velocity inside the shape");
     }
     return "# Scene file reference\n\nGenerated by `meniscus scene-reference`; every default "
            "shown is the one in the options struct.\n\n" +

@@ -2,6 +2,8 @@
 /// \file Scene files: JSON (SI units) read into options structs. Every key has its default in
 /// the struct below and nowhere else; `meniscus scene-reference` prints them all.
 
+#include "coupling/simulation.h"
+#include "fluid/fluid_solver.h"
 #include "tracker/implicit_shape.h"
 #include "tracker/surface_tracker.h"
 
@@ -16,12 +18,39 @@ struct SurfaceOptions {
     double edge_length = 0.02;  ///< requested mean edge length ξ of the generated mesh (m)
     std::string mesh_file;      ///< OBJ/PLY path, relative to the scene file (instead of shape)
     int remesh_iterations = 8;  ///< isotropic remeshing passes when meshing a shape
+    /// Which phase the shape encloses: "liquid" (drops, pools: region labels {1, 0}) or "gas"
+    /// (bubbles in a liquid that fills the rest: labels {0, 1}).
+    std::string inside = "liquid";
 };
 
 /// The motion that drives the surface until the fluid solver lands (paper §4 test modes).
 struct FlowOptions {
-    std::string type = "enright";  ///< "enright" (paper §4.3) or "none" (surface stays still)
-    double period = 3.0;           ///< Enright period T: velocity modulated by sin(2πt/T) (s)
+    /// "fluid" (the coupled Navier–Stokes solver moves the surface), "enright" (paper §4.3)
+    /// or "none" (the surface stays still).
+    std::string type = "enright";
+    double period = 3.0;  ///< Enright period T: velocity modulated by sin(2πt/T) (s)
+};
+
+/// The fluid's box: cubic cells, `cells` of them along x.
+struct DomainOptions {
+    Eigen::Vector3d min = Eigen::Vector3d::Zero();           ///< min corner (m)
+    Eigen::Vector3d size = Eigen::Vector3d::Constant(0.01);  ///< edge lengths (m)
+    int cells = 32;  ///< cells along x; dx = size.x / cells, other axes rounded to whole cells
+};
+
+/// Scene-level coupling choices beside the library's SimulationOptions.
+struct CouplingOptions {
+    /// Tracker target edge length in grid cells: when > 0, /surface/edge_length becomes
+    /// edge_length_cells · dx.
+    double edge_length_cells = 1.0;
+    coupling::SimulationOptions simulation;
+};
+
+/// A region of the initial flow that moves with a given velocity: every velocity face whose
+/// centre lies inside `shape` gets that component of `velocity` (later regions win).
+struct VelocityRegion {
+    tracker::ShapePtr shape;
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s
 };
 
 /// Simulated time and frames.
@@ -49,6 +78,10 @@ struct Scene {
     tracker::ShapePtr shape;  ///< set when the scene gives /surface/shape
     tracker::TrackerOptions tracker;
     FlowOptions flow;
+    DomainOptions domain;
+    fluid::FluidOptions fluid;
+    CouplingOptions coupling;
+    std::vector<VelocityRegion> initial_velocity;
     TimeOptions time;
     OutputOptions output;
     std::string source_path;  ///< the file it was read from

@@ -20,6 +20,49 @@ void initialize_openvdb_once() {
     std::call_once(flag, [] { openvdb::initialize(); });
 }
 
+/// Voxel (i, j, k) centred on fluid cell (i, j, k).
+openvdb::math::Transform::Ptr cell_centred_transform(const fluid::MacGrid& grid) {
+    auto t = openvdb::math::Transform::createLinearTransform(grid.dx());
+    const Eigen::Vector3d offset = grid.origin() + Eigen::Vector3d::Constant(0.5 * grid.dx());
+    t->postTranslate(openvdb::Vec3d(offset.x(), offset.y(), offset.z()));
+    return t;
+}
+
+void append_fluid_grids(const fluid::MacGrid& grid, const fluid::Array3<double>* pressure,
+                        openvdb::GridPtrVec& grids) {
+    const auto transform = cell_centred_transform(grid);
+    auto vel = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+    vel->setName("vel");
+    vel->setTransform(transform);
+    vel->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+    auto acc = vel->getAccessor();
+    for (int k = 0; k < grid.nz(); ++k)
+        for (int j = 0; j < grid.ny(); ++j)
+            for (int i = 0; i < grid.nx(); ++i) {
+                const float u =
+                    static_cast<float>(0.5 * (grid.u()(i, j, k) + grid.u()(i + 1, j, k)));
+                const float v =
+                    static_cast<float>(0.5 * (grid.v()(i, j, k) + grid.v()(i, j + 1, k)));
+                const float w =
+                    static_cast<float>(0.5 * (grid.w()(i, j, k) + grid.w()(i, j, k + 1)));
+                acc.setValue(openvdb::Coord(i, j, k), openvdb::Vec3s(u, v, w));
+            }
+    grids.push_back(vel);
+    if (pressure && pressure->ni() == grid.nx() && pressure->nj() == grid.ny() &&
+        pressure->nk() == grid.nz()) {
+        auto p = openvdb::FloatGrid::create(0.0f);
+        p->setName("pressure");
+        p->setTransform(transform->copy());
+        auto pacc = p->getAccessor();
+        for (int k = 0; k < grid.nz(); ++k)
+            for (int j = 0; j < grid.ny(); ++j)
+                for (int i = 0; i < grid.nx(); ++i)
+                    pacc.setValue(openvdb::Coord(i, j, k),
+                                  static_cast<float>((*pressure)(i, j, k)));
+        grids.push_back(p);
+    }
+}
+
 }  // namespace
 
 void VdbOutputOptions::validate() const {
@@ -30,7 +73,7 @@ void VdbOutputOptions::validate() const {
 }
 
 VdbOutputInfo write_surface_vdb(const std::string& path, const tracker::SurfaceMesh& mesh,
-                                const VdbOutputOptions& options) {
+                                const VdbOutputOptions& options, const FluidFields& fluid) {
     options.validate();
     initialize_openvdb_once();
 
@@ -74,6 +117,9 @@ VdbOutputInfo write_surface_vdb(const std::string& path, const tracker::SurfaceM
         info.density_active_voxels = static_cast<long long>(density->activeVoxelCount());
         grids.push_back(density);
     }
+
+    if (fluid.grid)
+        append_fluid_grids(*fluid.grid, fluid.pressure, grids);
 
     const std::string tmp = temporary_path_for(path);
     try {

@@ -13,6 +13,8 @@
 ///
 /// This is the only translation unit of Meniscus that instantiates OpenVDB's mesh tools.
 
+#include "fluid/array3.h"
+#include "fluid/mac_grid.h"
 #include "tracker/mesh.h"
 
 #include <string>
@@ -33,10 +35,19 @@ struct VdbOutputInfo {
     long long density_active_voxels = 0;
 };
 
+/// Fluid fields to add to the file (fluid scenes): grids `vel` (Vec3s, m/s, the face
+/// velocities averaged to cell centres) and `pressure` (float, Pa), dense over the fluid box,
+/// with a transform whose voxel centres are the fluid's cell centres (voxel size Δx, translated
+/// by origin + ½Δx).
+struct FluidFields {
+    const fluid::MacGrid* grid = nullptr;
+    const fluid::Array3<double>* pressure = nullptr;  ///< nx × ny × nz, may be null
+};
+
 /// Writes `path` atomically (temporary file + rename) with the grids above for the live
 /// triangles of `mesh`. Throws std::invalid_argument on bad options or an empty mesh,
 /// std::runtime_error if the file cannot be written.
 VdbOutputInfo write_surface_vdb(const std::string& path, const tracker::SurfaceMesh& mesh,
-                                const VdbOutputOptions& options);
+                                const VdbOutputOptions& options, const FluidFields& fluid = {});
 
 }  // namespace meniscus::coupling
