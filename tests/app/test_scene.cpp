@@ -77,7 +77,7 @@ TEST(Scene, ErrorsNameTheJsonPath) {
                   .find("/time/frames: expected an integer"),
               std::string::npos);
     EXPECT_NE(error_of(R"({"flow": {"type": "wind"}, "surface": {"shape": {"type": "sphere"}}})")
-                  .find("/flow/type: expected one of \"enright\", \"none\", got \"wind\""),
+                  .find("/flow/type: expected one of \"fluid\", \"enright\", \"none\", got \"wind\""),
               std::string::npos);
     EXPECT_NE(error_of("[1, 2]").find("/: expected an object"), std::string::npos);
 }
