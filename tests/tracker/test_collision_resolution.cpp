@@ -41,9 +41,9 @@ TrackerOptions verified() {
     return o;
 }
 
-TEST(CollisionResolution, PointDrivenThroughTriangleIsStopped) {
-    // A tetrahedron and a small tetrahedron above it driven straight down through it.
-    SurfaceMesh m(
+/// A tetrahedron (vertices 0–3, top face z = 0) and a small one above it (vertices 4–7).
+SurfaceMesh small_tetrahedron_above_big_one() {
+    return SurfaceMesh(
         {{0, 0, 0},
          {1, 0, 0},
          {0, 1, 0},
@@ -53,6 +53,11 @@ TEST(CollisionResolution, PointDrivenThroughTriangleIsStopped) {
          {0.2, 0.3, 0.3},
          {0.25, 0.25, 0.5}},
         {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}, {4, 6, 5}, {4, 5, 7}, {5, 6, 7}, {6, 4, 7}});
+}
+
+TEST(CollisionResolution, PointDrivenThroughTriangleIsStopped) {
+    // A tetrahedron and a small tetrahedron above it driven straight down through it.
+    SurfaceMesh m = small_tetrahedron_above_big_one();
     ASSERT_TRUE(is_intersection_free(m));
     std::vector<Vec3> x1 = m.positions();
     for (int v = 4; v < 8; ++v)
@@ -71,16 +76,7 @@ TEST(CollisionResolution, PointDrivenThroughTriangleIsStopped) {
 }
 
 TEST(CollisionResolution, PinnedVerticesDoNotMove) {
-    SurfaceMesh m(
-        {{0, 0, 0},
-         {1, 0, 0},
-         {0, 1, 0},
-         {0.3, 0.3, -1},
-         {0.2, 0.2, 0.1},
-         {0.3, 0.2, 0.3},
-         {0.2, 0.3, 0.3},
-         {0.25, 0.25, 0.5}},
-        {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}, {4, 6, 5}, {4, 5, 7}, {5, 6, 7}, {6, 4, 7}});
+    SurfaceMesh m = small_tetrahedron_above_big_one();
     std::vector<Vec3> x1 = m.positions();
     for (int v = 4; v < 8; ++v)
         x1[static_cast<size_t>(v)].z() -= 1.0;
