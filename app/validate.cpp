@@ -770,7 +770,7 @@ fig.tight_layout()
 fig.savefig(os.path.join(out, "a1_error.png"), dpi=120)
 plt.close(fig)
 
-def series_plot(case, key, name, ylabel, relative=False):
+def series_plot(case, key, name, ylabel, relative=False, extra=None):
     rs = sel(case)
     if not rs:
         return
@@ -781,6 +781,8 @@ def series_plot(case, key, name, ylabel, relative=False):
         if relative:
             y = [100.0 * (v - r["initial_volume"]) / r["initial_volume"] for v in y]
         ax.plot(s["t"], y, label="%s xi=%g" % (r["label"], r["xi_requested"]))
+        if extra is not None and "initial_radius" in r:
+            extra(ax, r)
     ax.set_xlabel("t (s)")
     ax.set_ylabel(ylabel)
     ax.set_title("%s: %s vs time" % (case, ylabel))
@@ -790,9 +792,20 @@ def series_plot(case, key, name, ylabel, relative=False):
     fig.savefig(os.path.join(out, name), dpi=120)
     plt.close(fig)
 
+def exact_sphere(ax, r):
+    import math
+    ts = r["series"]["t"]
+    r0 = r["initial_radius"]
+    ax.plot(ts, [4.0 / 3.0 * math.pi * (r0 * r0 - 4.0 * t) ** 1.5 for t in ts], "k:",
+            label="exact sphere R(t) = sqrt(R0^2 - 4t), xi=%g" % r["xi_requested"])
+
 for case in ("A1", "A2", "A3", "A4"):
     c = case.lower()
-    series_plot(case, "volume", c + "_volume.png", "volume change (%)", relative=True)
+    if case in ("A1", "A2"):  # growing and shrinking flows: the volume itself
+        series_plot(case, "volume", c + "_volume.png", "volume (m^3)",
+                    extra=exact_sphere if case == "A2" else None)
+    else:  # volume-preserving fields: the relative change
+        series_plot(case, "volume", c + "_volume.png", "volume change (%)", relative=True)
     series_plot(case, "triangles", c + "_triangles.png", "triangles")
 )PY";
 
