@@ -72,6 +72,46 @@ void SurfaceTensionOptions::validate() const {
                                     std::to_string(smoothing_passes));
 }
 
+std::vector<double> smooth_vertex_values(const tracker::SurfaceMesh& mesh,
+                                         std::vector<double> values, int passes) {
+    if (passes < 0)
+        throw std::invalid_argument("smooth_vertex_values: passes must be >= 0");
+    if (values.size() != static_cast<size_t>(mesh.num_vertices()))
+        throw std::invalid_argument("smooth_vertex_values: expected one value per vertex");
+    if (passes == 0)
+        return values;
+    // Lazy passes, x_v <- (x_v + neighbour mean)/2, not the closed one-ring mean
+    // (a_v x_v + sum a_w x_w)/(a_v + sum a_w): the latter keeps only ~1/7 of the vertex itself,
+    // so its transfer function is 1 - (6/7) lambda with lambda up to ~1.5 on a triangle mesh,
+    // i.e. about -0.27 for the roughest (mesh-scale) pattern. An odd number of such passes
+    // reverses the sign of the curvature of mesh-scale wrinkles, turning the capillary force on
+    // them from restoring into driving: a moving interface wrinkles and blows up (oscillating
+    // drop, scenes/oscillating_drop.json). The neighbour mean is a convex combination, so its
+    // eigenvalues lie in [-1, 1] and a lazy pass's in [0, 1]: every pattern keeps its sign.
+    const std::vector<double> area = tracker::mixed_voronoi_areas(mesh);
+    std::vector<double> smoothed(values.size(), 0.0);
+    for (int pass = 0; pass < passes; ++pass) {
+        tbb::parallel_for(0, mesh.num_vertices(), [&](int vi) {
+            const size_t v = static_cast<size_t>(vi);
+            smoothed[v] = values[v];
+            if (!mesh.vertex_alive(vi) || mesh.vertex_edges(vi).empty() ||
+                mesh.is_boundary_vertex(vi))
+                return;
+            double weighted = 0.0;
+            double total = 0.0;
+            for (int ei : mesh.vertex_edges(vi)) {
+                const size_t w = static_cast<size_t>(mesh.other_vertex(ei, vi));
+                weighted += area[w] * values[w];
+                total += area[w];
+            }
+            if (total > 0.0)
+                smoothed[v] = 0.5 * (values[v] + weighted / total);
+        });
+        values.swap(smoothed);
+    }
+    return values;
+}
+
 std::vector<double> liquid_vertex_curvatures(const tracker::SurfaceMesh& mesh, int liquid_region,
                                              int smoothing_passes) {
     if (smoothing_passes < 0)
@@ -80,31 +120,7 @@ std::vector<double> liquid_vertex_curvatures(const tracker::SurfaceMesh& mesh, i
     for (int vi = 0; vi < mesh.num_vertices(); ++vi)
         if (mesh.vertex_alive(vi))
             kappa[static_cast<size_t>(vi)] *= liquid_orientation(mesh, vi, liquid_region);
-    if (smoothing_passes == 0)
-        return kappa;
-
-    const std::vector<double> area = tracker::mixed_voronoi_areas(mesh);
-    std::vector<double> smoothed(kappa.size(), 0.0);
-    for (int pass = 0; pass < smoothing_passes; ++pass) {
-        tbb::parallel_for(0, mesh.num_vertices(), [&](int vi) {
-            const size_t v = static_cast<size_t>(vi);
-            if (!mesh.vertex_alive(vi) || mesh.vertex_edges(vi).empty() ||
-                mesh.is_boundary_vertex(vi)) {
-                smoothed[v] = kappa[v];
-                return;
-            }
-            double weighted = area[v] * kappa[v];
-            double total = area[v];
-            for (int ei : mesh.vertex_edges(vi)) {
-                const size_t w = static_cast<size_t>(mesh.other_vertex(ei, vi));
-                weighted += area[w] * kappa[w];
-                total += area[w];
-            }
-            smoothed[v] = total > 0.0 ? weighted / total : kappa[v];
-        });
-        kappa.swap(smoothed);
-    }
-    return kappa;
+    return smooth_vertex_values(mesh, std::move(kappa), smoothing_passes);
 }
 
 SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,

@@ -3,11 +3,11 @@
 /// level set crosses, as the fluid's ghost-fluid pressure jump p_liquid − p_gas = σκ needs it.
 ///
 /// κ comes from the mesh, not from derivatives of φ: the cotangent mean curvature at vertices
-/// (tracker/flows/mean_curvature.h, Meyer et al. 2003), optionally smoothed by area-weighted
-/// one-ring averaging, then interpolated barycentrically at the point of the mesh closest to each
-/// crossing x = x_lo + θ (x_hi − x_lo), θ = φ_lo / (φ_lo − φ_hi), between the centres of the two
-/// cells next to the face; the closest triangle is found by walk_to_closest_triangle() from the
-/// closest triangles of those two cells.
+/// (tracker/flows/mean_curvature.h, Meyer et al. 2003), optionally smoothed by lazy
+/// area-weighted one-ring averaging (smooth_vertex_values()), then interpolated barycentrically at
+/// the point of the mesh closest to each crossing x = x_lo + θ (x_hi − x_lo), θ = φ_lo / (φ_lo −
+/// φ_hi), between the centres of the two cells next to the face; the closest triangle is found by
+/// walk_to_closest_triangle() from the closest triangles of those two cells.
 ///
 /// Sign: the fluid's convention — κ > 0 for a convex liquid blob (a drop), < 0 around a gas
 /// bubble. The mesh's per-vertex κ is positive where the surface is convex as seen from the side
@@ -26,11 +26,13 @@ namespace meniscus::coupling {
 
 /// Options of the curvature at face crossings.
 struct SurfaceTensionOptions {
-    /// Area-weighted one-ring averaging passes over the vertex curvature before it is
-    /// interpolated (0 = raw cotangent curvature). Each pass widens the averaging stencil by one
-    /// ring of edges. Trade-off measured in tests/coupling/test_surface_tension.cpp (mesh edge ≈
-    /// dx): 2 passes cut the spurious currents of a static drop about 30× but smooth real
-    /// variations of κ (an ellipsoid's rms κ error at dx = 1/32 grows from 1 % to 2.6 %).
+    /// Lazy area-weighted one-ring averaging passes over the vertex curvature before it is
+    /// interpolated (0 = raw cotangent curvature; see smooth_vertex_values()). Each pass widens
+    /// the averaging stencil by one ring of edges. Trade-off with mesh edge ≈ dx, measured with
+    /// the static drop (16.6 cells per diameter) and ellipsoid (dx = 1/32) of
+    /// tests/coupling/test_surface_tension.cpp: spurious currents cut 2.3×, 5×, 10×, 20× by
+    /// 1, 2, 3, 4 passes while the ellipsoid's rms κ error grows 0.9 % → 1.25, 1.8, 2.3, 2.85 %.
+    /// Any count is stable on a moving mesh (mesh-scale patterns are damped, never reversed).
     int smoothing_passes = 0;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
@@ -47,9 +49,19 @@ struct SurfaceTensionResult {
     double face_seconds = 0.0;    ///< interpolation to the faces, wall clock
 };
 
+/// `passes` lazy one-ring smoothing passes over per-vertex `values` (sized num_vertices()):
+/// x_v ← ½ x_v + ½ Σ_w A_w x_w / Σ_w A_w over the neighbours w (A = mixed Voronoi area).
+/// Dead, isolated and boundary vertices keep their value. Being lazy, a pass damps every
+/// pattern by a factor in [0, 1] and never reverses one: the closed one-ring mean (vertex weighted
+/// like a neighbour) maps the mesh-scale pattern to about −0.27 times itself, which turns the
+/// capillary force on mesh-scale wrinkles from restoring into driving (a moving drop blows up).
+/// Throws std::invalid_argument if passes < 0 or values has the wrong size.
+std::vector<double> smooth_vertex_values(const tracker::SurfaceMesh& mesh,
+                                         std::vector<double> values, int passes);
+
 /// Signed mean curvature κ (1/m, sum of principal curvatures) per vertex in the fluid's sign
-/// convention (see the file comment), smoothed by `smoothing_passes` area-weighted one-ring
-/// averages. Sized num_vertices(); zero for dead, isolated and boundary vertices.
+/// convention (see the file comment), smoothed by `smoothing_passes` passes of
+/// smooth_vertex_values(). Sized num_vertices(); zero for dead, isolated and boundary vertices.
 std::vector<double> liquid_vertex_curvatures(const tracker::SurfaceMesh& mesh, int liquid_region,
                                              int smoothing_passes);
 
