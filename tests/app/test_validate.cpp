@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -39,7 +41,9 @@ constexpr double ENRIGHT_QUICK_RETURN_LINF = 0.01;
 class QuickValidation : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
-        s_out = fs::temp_directory_path() / "meniscus_test_validate";
+        // One folder per process: other build folders may run this test at the same time.
+        s_out = fs::temp_directory_path() /
+                ("meniscus_test_validate_" + std::to_string(static_cast<long>(::getpid())));
         fs::remove_all(s_out);
         ValidateOptions options;
         options.out_dir = s_out.string();
@@ -52,6 +56,8 @@ protected:
         text << r.rdbuf();
         s_report = text.str();
     }
+
+    static void TearDownTestSuite() { fs::remove_all(s_out); }
 
     static std::vector<Json> runs(const std::string& case_id, const std::string& label) {
         std::vector<Json> out;
@@ -82,7 +88,8 @@ TEST_F(QuickValidation, EveryRunFinishesWithoutIntersections) {
         EXPECT_TRUE(r["completed"].get<bool>());
         EXPECT_EQ(r["initial_intersecting_pairs"].get<int>(), 0);
         if (!r["collision_safety"].get<bool>()) {
-            // The spheres grow through each other: the count is reported and not zero.
+            // A1: the spheres grow through each other; A4: curl noise folds the surface onto
+            // itself. The count is reported and not zero.
             EXPECT_GT(r["max_intersecting_pairs"].get<int>(), 0);
             ++unsafe_runs;
             continue;
@@ -92,7 +99,7 @@ TEST_F(QuickValidation, EveryRunFinishesWithoutIntersections) {
             EXPECT_EQ(pairs.get<int>(), 0);
         EXPECT_EQ(r["series"]["t"].size(), static_cast<size_t>(r["steps"].get<long>()) + 1);
     }
-    EXPECT_EQ(unsafe_runs, 1);
+    EXPECT_EQ(unsafe_runs, 2);
 }
 
 TEST_F(QuickValidation, NormalFlowCoarseErrorsAgainstThePaper) {
@@ -129,11 +136,11 @@ TEST_F(QuickValidation, ReportHasEveryCaseTable) {
     ASSERT_TRUE(fs::exists(s_out / "report.md"));
     for (const char* heading : {"## A1", "## A2", "## A3", "## A4", "## A5"})
         EXPECT_NE(s_report.find(heading), std::string::npos) << heading;
-    for (const char* table :
-         {"| ξ | measured ξ | t | steps | triangles | L∞ | L∞ paper",
-          "| ξ | triangles | improvement", "| ξ | R₀ | t | steps | exact R(t)",
-          "| ξ | period | steps | triangles | volume change %",
-          "| ξ | t | steps | max intersecting pairs | steps with intersections"})
+    for (const char* table : {"| ξ | measured ξ | t | steps | triangles | L∞ | L∞ paper",
+                              "| ξ | triangles | improvement", "| ξ | R₀ | t | steps | exact R(t)",
+                              "| ξ | period | steps | triangles | volume change %",
+                              "| ξ | t | steps | max intersecting pairs | steps with intersections",
+                              "| run | ξ | t | steps | triangles | volume change %"})
         EXPECT_NE(s_report.find(table), std::string::npos) << table;
     EXPECT_NE(s_report.find("0.00811073"), std::string::npos);  // the paper's numbers beside ours
 }
