@@ -272,6 +272,14 @@ struct CylinderParams {
     double radius = 0.1;
     double height = 0.5;
 };
+struct PerturbedCylinderParams {
+    Vec3 center = Vec3::Zero();
+    Vec3 axis = Vec3::UnitX();
+    double radius = 0.1;
+    double height = 1.0;
+    double amplitude = 0.01;
+    double wavelength = 0.9;
+};
 struct TorusParams {
     Vec3 center = Vec3::Zero();
     Vec3 axis = Vec3::UnitZ();
@@ -311,6 +319,16 @@ void visit_fields(V& v, CylinderParams& p) {
     v.number("height", p.height, Range::positive(), "m", "length along the axis (capped)");
 }
 template <typename V>
+void visit_fields(V& v, PerturbedCylinderParams& p) {
+    v.vec3("center", p.center, Range::any(), "m", "centre of the axis segment");
+    v.vec3("axis", p.axis, Range::any(), "", "axis direction (normalized)");
+    v.number("radius", p.radius, Range::positive(), "m", "mean radius R");
+    v.number("height", p.height, Range::positive(), "m", "length along the axis (capped)");
+    v.number("amplitude", p.amplitude, Range{0.0, 1.0, false, true}, "",
+             "relative radius perturbation ε: r(s) = R(1 + ε cos(2πs/λ))");
+    v.number("wavelength", p.wavelength, Range::positive(), "m", "perturbation wavelength λ");
+}
+template <typename V>
 void visit_fields(V& v, TorusParams& p) {
     v.vec3("center", p.center, Range::any(), "m", "centre");
     v.vec3("axis", p.axis, Range::any(), "", "axis of symmetry");
@@ -330,9 +348,9 @@ void visit_fields(V& v, DumbbellParams& p) {
              "smooth-minimum blend where handle meets balls");
 }
 
-const std::vector<std::string> SHAPE_TYPES = {"sphere",   "ellipsoid",    "box",
-                                              "cylinder", "torus",        "dumbbell",
-                                              "union",    "intersection", "difference"};
+const std::vector<std::string> SHAPE_TYPES = {
+    "sphere", "ellipsoid", "box",   "cylinder",     "perturbed_cylinder",
+    "torus",  "dumbbell",  "union", "intersection", "difference"};
 
 template <typename Params>
 Params read_params(JsonReader& r) {
@@ -363,7 +381,7 @@ ShapePtr parse_shape(const nlohmann::json& j, const std::string& path) {
     r.choice("type", type, SHAPE_TYPES, "");
     if (type.empty())
         r.fail("type",
-               "required: one of sphere, ellipsoid, box, cylinder, torus, "
+               "required: one of sphere, ellipsoid, box, cylinder, perturbed_cylinder, torus, "
                "dumbbell, union, intersection, difference");
     try {
         if (type == "sphere") {
@@ -381,6 +399,11 @@ ShapePtr parse_shape(const nlohmann::json& j, const std::string& path) {
         if (type == "cylinder") {
             const auto p = read_params<CylinderParams>(r);
             return tracker::make_cylinder(p.center, p.axis, p.radius, p.height);
+        }
+        if (type == "perturbed_cylinder") {
+            const auto p = read_params<PerturbedCylinderParams>(r);
+            return tracker::make_perturbed_cylinder(p.center, p.axis, p.radius, p.height,
+                                                    p.amplitude, p.wavelength);
         }
         if (type == "torus") {
             const auto p = read_params<TorusParams>(r);
@@ -506,14 +529,15 @@ std::string scene_reference_markdown() {
                               "An implicit shape: an object with `type` and that type's keys. "
                               "`union`/`intersection` take `shapes` (array of shapes), "
                               "`difference` takes `a` minus `b`.");
-        shape.add(
-            {"type", "string", "(required)", "",
-             "sphere, ellipsoid, box, cylinder, torus, dumbbell, union, intersection, difference"});
+        shape.add({"type", "string", "(required)", "",
+                   "sphere, ellipsoid, box, cylinder, perturbed_cylinder, torus, dumbbell, union, "
+                   "intersection, difference"});
         SphereParams sp;
         EllipsoidParams ep;
         BoxParams bp;
         CylinderParams cp;
         TorusParams tp;
+        PerturbedCylinderParams pp;
         DumbbellParams dp;
         ReferenceWriter s1(tables, "/surface/shape (type sphere)", "");
         visit_fields(s1, sp);
@@ -523,6 +547,8 @@ std::string scene_reference_markdown() {
         visit_fields(s3, bp);
         ReferenceWriter s4(tables, "/surface/shape (type cylinder)", "");
         visit_fields(s4, cp);
+        ReferenceWriter s7(tables, "/surface/shape (type perturbed_cylinder)", "");
+        visit_fields(s7, pp);
         ReferenceWriter s5(tables, "/surface/shape (type torus)", "");
         visit_fields(s5, tp);
         ReferenceWriter s6(tables, "/surface/shape (type dumbbell)", "");

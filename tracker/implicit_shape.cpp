@@ -111,6 +111,42 @@ private:
     double m_r, m_half;
 };
 
+class PerturbedCylinder final : public ImplicitShape {
+public:
+    PerturbedCylinder(const Vector3d& c, const Vector3d& axis, double r, double height,
+                      double amplitude, double wavelength)
+        : m_c(c),
+          m_a(normalized_axis(axis)),
+          m_r(r),
+          m_half(0.5 * height),
+          m_eps(amplitude),
+          m_k(2.0 * M_PI / wavelength) {
+        require_positive(r, "perturbed cylinder radius");
+        require_positive(height, "perturbed cylinder height");
+        require_positive(wavelength, "perturbed cylinder wavelength");
+        if (!(amplitude >= 0.0 && amplitude < 1.0))
+            throw std::invalid_argument("perturbed cylinder amplitude must be in [0, 1)");
+    }
+    double value(const Vector3d& x) const override {
+        const Vector3d d = x - m_c;
+        const double along = d.dot(m_a);
+        const double radial = (d - along * m_a).norm();
+        const double qx = radial - m_r * (1.0 + m_eps * std::cos(m_k * along));
+        const double qy = std::abs(along) - m_half;
+        return std::hypot(std::max(qx, 0.0), std::max(qy, 0.0)) + std::min(std::max(qx, qy), 0.0);
+    }
+    Box3 bounds() const override {
+        const double r = m_r * (1.0 + m_eps);
+        const Vector3d ext = m_a.cwiseAbs() * m_half +
+                             r * (Vector3d::Ones() - m_a.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
+        return Box3(m_c - ext, m_c + ext);
+    }
+
+private:
+    Vector3d m_c, m_a;
+    double m_r, m_half, m_eps, m_k;
+};
+
 class Torus final : public ImplicitShape {
 public:
     Torus(const Vector3d& c, const Vector3d& axis, double major, double minor)
@@ -251,6 +287,10 @@ ShapePtr make_box(const Vector3d& min_corner, const Vector3d& max_corner) {
 }
 ShapePtr make_cylinder(const Vector3d& center, const Vector3d& axis, double radius, double height) {
     return std::make_shared<Cylinder>(center, axis, radius, height);
+}
+ShapePtr make_perturbed_cylinder(const Vector3d& center, const Vector3d& axis, double radius,
+                                 double height, double amplitude, double wavelength) {
+    return std::make_shared<PerturbedCylinder>(center, axis, radius, height, amplitude, wavelength);
 }
 ShapePtr make_torus(const Vector3d& center, const Vector3d& axis, double major_radius,
                     double minor_radius) {

@@ -41,6 +41,11 @@ ShapePtr make_box(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& max_
 /// `height` (> 0).
 ShapePtr make_cylinder(const Eigen::Vector3d& center, const Eigen::Vector3d& axis, double radius,
                        double height);
+/// Capped cylinder whose radius varies along the axis as r(s) = radius·(1 + amplitude·cos(2πs /
+/// wavelength)), s measured from the centre (Rayleigh–Plateau initial condition). amplitude in
+/// [0, 1), wavelength > 0. φ is the radial gap r − r(s) (a distance bound for small amplitude).
+ShapePtr make_perturbed_cylinder(const Eigen::Vector3d& center, const Eigen::Vector3d& axis,
+                                 double radius, double height, double amplitude, double wavelength);
 /// Torus around `axis` through `center`: tube centre circle `major_radius`, tube
 /// `minor_radius` (0 < minor < major).
 ShapePtr make_torus(const Eigen::Vector3d& center, const Eigen::Vector3d& axis, double major_radius,

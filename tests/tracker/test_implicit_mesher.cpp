@@ -91,6 +91,16 @@ TEST(ImplicitMesher, ShapeSmallerThanTheGridGivesAClearError) {
     }
 }
 
+TEST(ImplicitShapes, PerturbedCylinderRadiusFollowsTheCosine) {
+    const auto c = make_perturbed_cylinder({0, 0, 0}, {1, 0, 0}, 0.5, 10.0, 0.1, 2.0);
+    EXPECT_NEAR(c->value({0.0, 0.55, 0.0}), 0.0, 1e-15);  // crest at s = 0: r = 0.55
+    EXPECT_NEAR(c->value({1.0, 0.0, 0.45}), 0.0, 1e-15);  // trough at s = λ/2: r = 0.45
+    EXPECT_LT(c->value({1.0, 0.0, 0.44}), 0.0);
+    EXPECT_GT(c->value({5.5, 0.0, 0.0}), 0.0);  // beyond the cap
+    EXPECT_THROW(make_perturbed_cylinder({0, 0, 0}, {1, 0, 0}, 0.5, 1.0, 1.0, 2.0),
+                 std::invalid_argument);
+}
+
 TEST(ImplicitShapes, RejectBadParameters) {
     EXPECT_THROW(make_sphere({0, 0, 0}, -1.0), std::invalid_argument);
     EXPECT_THROW(make_torus({0, 0, 0}, {0, 0, 1}, 0.1, 0.2), std::invalid_argument);
