@@ -215,6 +215,20 @@ SurfaceMesh build_initial_surface(const Scene& scene, std::string* report) {
     return mesh;
 }
 
+/// True (with `result` filled in) when the run must stop before the next step: Ctrl-C or
+/// RunOptions::max_steps reached.
+bool should_stop(const RunOptions& options, const std::atomic<bool>& stop, double t,
+                 Progress& progress, RunResult& result) {
+    const bool interrupted = stop.load();
+    if (!interrupted && !(options.max_steps > 0 && result.steps >= options.max_steps))
+        return false;
+    progress.finish();
+    result.interrupted = interrupted;
+    result.reached_max_steps = !interrupted;
+    result.simulated_time = t;
+    return true;
+}
+
 /// Sets every face whose centre lies inside a region's shape to that region's velocity.
 void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::MacGrid& grid) {
     for (int axis = 0; axis < 3; ++axis) {
@@ -310,13 +324,8 @@ RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
         double rasterize = 0.0, fluid_s = 0.0, interpolate = 0.0, tracker_s = 0.0;
         long long intersecting = -1, merges = 0, splits = 0, shortenings = 0;
         while (t < t_frame) {
-            if (stop.load() || (options.max_steps > 0 && result.steps >= options.max_steps)) {
-                progress.finish();
-                result.interrupted = stop.load();
-                result.reached_max_steps = !result.interrupted;
-                result.simulated_time = t;
+            if (should_stop(options, stop, t, progress, result))
                 return result;
-            }
             last = sim.step(t_frame - t);
             rasterize += last.rasterize_seconds;
             fluid_s += last.fluid_seconds;
@@ -387,13 +396,8 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
         long long steps = 0;
         work = FrameWork{};
         while (t < t_frame) {
-            if (stop.load() || (options.max_steps > 0 && result.steps >= options.max_steps)) {
-                progress.finish();
-                result.interrupted = stop.load();
-                result.reached_max_steps = !result.interrupted;
-                result.simulated_time = t;
+            if (should_stop(options, stop, t, progress, result))
                 return result;
-            }
             dt = std::min(scene.time.dt, t_frame - t);
             auto start = Clock::now();
             tracker.improve();
