@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 
-DEFAULT_SCENE=scenes/flows/enright.json
+DEFAULT_SCENE=scenes/drop_merge.json
 BUILD_DIR=${MENISCUS_BUILD_DIR:-build}
 PACKAGES=(cmake ninja-build g++ ccache libeigen3-dev libtbb-dev libopenvdb-dev libboost-iostreams-dev
           nlohmann-json3-dev libgtest-dev libbenchmark-dev libgmp-dev python3-matplotlib python3-numpy)
