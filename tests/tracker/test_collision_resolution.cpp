@@ -165,7 +165,7 @@ TEST(CollisionStress, SphereCrushedByRandomField) {
     std::mt19937 rng(11);
     std::normal_distribution<double> noise(0.0, 1.0);
     int shortened = 0;
-    for (int step = 0; step < 1000; ++step) {
+    for (int step = 0; step < 2000; ++step) {
         std::vector<Vec3> v(static_cast<size_t>(m.num_vertices()));
         for (int vi = 0; vi < m.num_vertices(); ++vi)
             v[static_cast<size_t>(vi)] =
