@@ -11,7 +11,7 @@
 /// (i, j, k) · voxel_size (a linear transform with no offset). Blender draws voxel (i, j, k)
 /// as the cube [i, i+1] · voxel_size, half a voxel off; see README "Rendering".
 ///
-/// This is the only translation unit of Meniscus that instantiates OpenVDB's mesh tools.
+/// OpenVDB's mesh tools are instantiated only here (output) and in rasterize.cpp (coupling).
 
 #include "fluid/array3.h"
 #include "fluid/mac_grid.h"
