@@ -286,6 +286,13 @@ struct TorusParams {
     double major_radius = 0.3;
     double minor_radius = 0.1;
 };
+struct WavyHalfSpaceParams {
+    Vec3 origin = Vec3::Zero();
+    Vec3 up = Vec3::UnitZ();
+    Vec3 direction = Vec3::UnitX();
+    double amplitude = 0.01;
+    double wavelength = 1.0;
+};
 /// Defaults: a Sethian-style dumbbell sized so that, under mean-curvature flow, the handle
 /// pinches off before t = 0.025 while the bulbs survive (paper §4.2, Fig. 4.3).
 struct DumbbellParams {
@@ -348,9 +355,23 @@ void visit_fields(V& v, DumbbellParams& p) {
              "smooth-minimum blend where handle meets balls");
 }
 
+template <typename V>
+void visit_fields(V& v, WavyHalfSpaceParams& p) {
+    v.vec3("origin", p.origin, Range::any(), "m",
+           "a crest on the mean plane: the surface passes through origin + amplitude·up");
+    v.vec3("up", p.up, Range::any(), "",
+           "outward normal of the mean plane (normalized); the region lies below");
+    v.vec3("direction", p.direction, Range::any(), "",
+           "wave direction (its component along `up` is removed, then normalized)");
+    v.number("amplitude", p.amplitude, Range::non_negative(), "m",
+             "A: the surface is s = A cos(2π t / λ), s along `up`, t along `direction`, both "
+             "measured from `origin`");
+    v.number("wavelength", p.wavelength, Range::positive(), "m", "λ");
+}
+
 const std::vector<std::string> SHAPE_TYPES = {
     "sphere", "ellipsoid", "box",   "cylinder",     "perturbed_cylinder",
-    "torus",  "dumbbell",  "union", "intersection", "difference"};
+    "torus",  "dumbbell",  "wavy_half_space", "union", "intersection", "difference"};
 
 template <typename Params>
 Params read_params(JsonReader& r) {
@@ -382,7 +403,7 @@ ShapePtr parse_shape(const nlohmann::json& j, const std::string& path) {
     if (type.empty())
         r.fail("type",
                "required: one of sphere, ellipsoid, box, cylinder, perturbed_cylinder, torus, "
-               "dumbbell, union, intersection, difference");
+               "dumbbell, wavy_half_space, union, intersection, difference");
     try {
         if (type == "sphere") {
             const auto p = read_params<SphereParams>(r);
@@ -413,6 +434,11 @@ ShapePtr parse_shape(const nlohmann::json& j, const std::string& path) {
             const auto p = read_params<DumbbellParams>(r);
             return tracker::make_dumbbell(p.center, p.bulb_radius, p.separation, p.handle_radius,
                                           p.blend_radius);
+        }
+        if (type == "wavy_half_space") {
+            const auto p = read_params<WavyHalfSpaceParams>(r);
+            return tracker::make_wavy_half_space(p.origin, p.up, p.direction, p.amplitude,
+                                                 p.wavelength);
         }
         if (type == "union" || type == "intersection") {
             auto shapes = parse_shape_list(r, "shapes");
@@ -530,8 +556,8 @@ std::string scene_reference_markdown() {
                               "`union`/`intersection` take `shapes` (array of shapes), "
                               "`difference` takes `a` minus `b`.");
         shape.add({"type", "string", "(required)", "",
-                   "sphere, ellipsoid, box, cylinder, perturbed_cylinder, torus, dumbbell, union, "
-                   "intersection, difference"});
+                   "sphere, ellipsoid, box, cylinder, perturbed_cylinder, torus, dumbbell, "
+                   "wavy_half_space, union, intersection, difference"});
         SphereParams sp;
         EllipsoidParams ep;
         BoxParams bp;
@@ -553,6 +579,12 @@ std::string scene_reference_markdown() {
         visit_fields(s5, tp);
         ReferenceWriter s6(tables, "/surface/shape (type dumbbell)", "");
         visit_fields(s6, dp);
+        WavyHalfSpaceParams wp;
+        ReferenceWriter s8(tables, "/surface/shape (type wavy_half_space)",
+                           "Unbounded: the region below a cosine-perturbed plane. Use it inside an "
+                           "`intersection` with a box (e.g. a liquid slab for a capillary wave; "
+                           "the box may extend past the fluid domain's walls).");
+        visit_fields(s8, wp);
     }
     {
         ReferenceWriter velocity(

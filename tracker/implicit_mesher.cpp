@@ -39,6 +39,9 @@ public:
         const Box3 b = shape.bounds();
         if (b.isEmpty())
             throw std::runtime_error("shape has empty bounds");
+        if (!b.min().allFinite() || !b.max().allFinite())
+            throw std::invalid_argument(
+                "shape is unbounded (e.g. a half-space): intersect it with a box");
         m_origin = b.min() - Vec3::Constant(PADDING_CELLS * h);
         for (int i = 0; i < 3; ++i)
             m_n[i] = static_cast<int>(std::ceil(b.sizes()[i] / h)) + 2 * PADDING_CELLS + 1;

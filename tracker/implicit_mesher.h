@@ -29,8 +29,9 @@ struct ImplicitMeshReport {
     double max_abs_phi = 0.0;  ///< largest |φ| over vertices (how far off the surface)
 };
 
-/// Meshes `shape`. Throws std::invalid_argument on bad options, std::runtime_error if the shape
-/// produces no surface at this resolution (e.g. smaller than the edge length).
+/// Meshes `shape`. Throws std::invalid_argument on bad options or an unbounded shape (a
+/// half-space not intersected with a box), std::runtime_error if the shape produces no surface
+/// at this resolution (e.g. smaller than the edge length).
 SurfaceMesh mesh_implicit_shape(const ImplicitShape& shape, const ImplicitMeshOptions& options,
                                 ImplicitMeshReport* report = nullptr);
 

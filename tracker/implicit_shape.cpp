@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -201,6 +202,49 @@ private:
     double m_bulb, m_half, m_handle, m_blend;
 };
 
+class WavyHalfSpace final : public ImplicitShape {
+public:
+    WavyHalfSpace(const Vector3d& origin, const Vector3d& up, const Vector3d& direction,
+                  double amplitude, double wavelength)
+        : m_o(origin), m_n(normalized_axis(up)), m_A(amplitude) {
+        require_positive(wavelength, "wavy half-space wavelength");
+        if (!(amplitude >= 0.0) || !std::isfinite(amplitude))
+            throw std::invalid_argument("wavy half-space amplitude must be a finite number >= 0");
+        const Vector3d tangential = direction - direction.dot(m_n) * m_n;
+        if (!(tangential.norm() > PARALLEL_TOLERANCE * direction.norm()))
+            throw std::invalid_argument(
+                "wavy half-space direction must be a non-zero vector not parallel to up");
+        m_d = tangential.normalized();
+        m_k = 2.0 * M_PI / wavelength;
+        m_scale = 1.0 / std::sqrt(1.0 + (m_A * m_k) * (m_A * m_k));
+    }
+    double value(const Vector3d& x) const override {
+        const Vector3d r = x - m_o;
+        return (r.dot(m_n) - m_A * std::cos(m_k * r.dot(m_d))) * m_scale;
+    }
+    Vector3d gradient(const Vector3d& x) const override {
+        const double t = (x - m_o).dot(m_d);
+        return (m_n + m_A * m_k * std::sin(m_k * t) * m_d) * m_scale;
+    }
+    Box3 bounds() const override {
+        constexpr double INF = std::numeric_limits<double>::infinity();
+        Vector3d lo = Vector3d::Constant(-INF), hi = Vector3d::Constant(INF);
+        for (int i = 0; i < 3; ++i) {
+            if (m_n[i] == 1.0)
+                hi[i] = m_o[i] + m_A;
+            if (m_n[i] == -1.0)
+                lo[i] = m_o[i] - m_A;
+        }
+        return Box3(lo, hi);
+    }
+
+private:
+    /// `direction` counts as parallel to `up` below this relative tangential length.
+    static constexpr double PARALLEL_TOLERANCE = 1e-9;
+    Vector3d m_o, m_n, m_d;
+    double m_A, m_k = 0.0, m_scale = 1.0;
+};
+
 class Combination final : public ImplicitShape {
 public:
     enum class Op { Union, Intersection };
@@ -299,6 +343,10 @@ ShapePtr make_torus(const Vector3d& center, const Vector3d& axis, double major_r
 ShapePtr make_dumbbell(const Vector3d& center, double bulb_radius, double separation,
                        double handle_radius, double blend_radius) {
     return std::make_shared<Dumbbell>(center, bulb_radius, separation, handle_radius, blend_radius);
+}
+ShapePtr make_wavy_half_space(const Vector3d& origin, const Vector3d& up, const Vector3d& direction,
+                              double amplitude, double wavelength) {
+    return std::make_shared<WavyHalfSpace>(origin, up, direction, amplitude, wavelength);
 }
 ShapePtr make_union(std::vector<ShapePtr> shapes) {
     return std::make_shared<Combination>(std::move(shapes), Combination::Op::Union);

@@ -55,6 +55,19 @@ ShapePtr make_torus(const Eigen::Vector3d& center, const Eigen::Vector3d& axis, 
 /// smooth minimum so the surface is C¹ where the handle meets the bulbs.
 ShapePtr make_dumbbell(const Eigen::Vector3d& center, double bulb_radius, double separation,
                        double handle_radius, double blend_radius);
+/// Half-space below a cosine-perturbed plane (an unbounded region; intersect it with a box to
+/// get a closed slab). With s = (x − origin)·up and t = (x − origin)·direction, the region is
+/// s < amplitude·cos(2π t / wavelength): `origin` is a crest of the mean plane, `up` the unit
+/// normal pointing out of the region (normalized inside), `direction` the wave direction (its
+/// component along `up` is removed, then normalized). Example: up = e_z, direction = e_x,
+/// origin = (x0, 0, h) gives z < h + A·cos(2π(x − x0)/λ). φ = (s − A cos(2πt/λ)) / sqrt(1 + (2πA/λ)²),
+/// so |∇φ| ≤ 1 and |φ| is a lower bound on the distance to the surface. bounds() is infinite
+/// except on the side `up` points to when `up` is a coordinate axis. Throws
+/// std::invalid_argument on amplitude < 0, wavelength ≤ 0, zero vectors, or `direction`
+/// parallel to `up`.
+ShapePtr make_wavy_half_space(const Eigen::Vector3d& origin, const Eigen::Vector3d& up,
+                              const Eigen::Vector3d& direction, double amplitude,
+                              double wavelength);
 /// Union of one or more shapes (min of values).
 ShapePtr make_union(std::vector<ShapePtr> shapes);
 /// Intersection of one or more shapes (max of values).

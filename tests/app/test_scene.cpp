@@ -82,6 +82,26 @@ TEST(Scene, ErrorsNameTheJsonPath) {
     EXPECT_NE(error_of("[1, 2]").find("/: expected an object"), std::string::npos);
 }
 
+TEST(Scene, WavyHalfSpaceSlab) {
+    const Scene s = parse_scene(R"({"surface": {"shape": {"type": "intersection", "shapes": [
+        {"type": "wavy_half_space", "origin": [0.25, 0, 0.5], "amplitude": 0.05,
+         "wavelength": 1.0},
+        {"type": "box", "min": [-1, -1, 0], "max": [2, 2, 1]}]}}})",
+                                "t.json", ".");
+    ASSERT_TRUE(s.shape);
+    // z = 0.5 + 0.05 cos(2π(x − 0.25)): crest at x = 0.25, trough at x = 0.75.
+    EXPECT_LT(s.shape->value({0.25, 0.0, 0.54}), 0.0);
+    EXPECT_GT(s.shape->value({0.25, 0.0, 0.56}), 0.0);
+    EXPECT_GT(s.shape->value({0.75, 0.0, 0.46}), 0.0);
+    EXPECT_LT(s.shape->value({0.75, 0.0, 0.44}), 0.0);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "wavy_half_space", "wavelength": 0}}})")
+                  .find("/surface/shape/wavelength: expected a number > 0"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "wavy_half_space", "direction": [0, 0, 1]}}})")
+                  .find("/surface/shape: wavy half-space direction must be"),
+              std::string::npos);
+}
+
 TEST(Scene, MeshFileIsRelativeToTheScene) {
     const Scene s = parse_scene(R"({"surface": {"mesh_file": "m.obj"}})", "dir/s.json", "dir");
     EXPECT_EQ(s.surface.mesh_file, "dir/m.obj");

@@ -1,9 +1,11 @@
 #include "tracker/implicit_mesher.h"
+#include "tracker/mesh_intersections.h"
 #include "tracker/mesh_measures.h"
 #include "tracker/mesh_validate.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -99,6 +101,85 @@ TEST(ImplicitShapes, PerturbedCylinderRadiusFollowsTheCosine) {
     EXPECT_GT(c->value({5.5, 0.0, 0.0}), 0.0);  // beyond the cap
     EXPECT_THROW(make_perturbed_cylinder({0, 0, 0}, {1, 0, 0}, 0.5, 1.0, 1.0, 2.0),
                  std::invalid_argument);
+}
+
+TEST(ImplicitShapes, WavyHalfSpaceFollowsTheCosineWithUnitLipschitzBound) {
+    // z < 0.5 + 0.1 cos(2π(x − 0.2)/0.4)
+    const auto w = make_wavy_half_space({0.2, 0, 0.5}, {0, 0, 1}, {1, 0, 0}, 0.1, 0.4);
+    EXPECT_NEAR(w->value({0.2, 0.3, 0.6}), 0.0, 1e-15);  // crest at x = x0
+    EXPECT_NEAR(w->value({0.4, -1.0, 0.4}), 0.0, 1e-15);  // trough half a wavelength on
+    EXPECT_LT(w->value({0.4, 0.0, 0.39}), 0.0);
+    EXPECT_GT(w->value({0.4, 0.0, 0.41}), 0.0);
+    // |φ| never exceeds the distance to the surface: sample points against a dense polyline.
+    for (double x = -0.3; x < 0.7; x += 0.037)
+        for (double z = 0.2; z < 0.8; z += 0.041) {
+            double dist = 1e300;
+            for (double s = -1.0; s < 1.5; s += 1e-4) {
+                const double zs = 0.5 + 0.1 * std::cos(2 * PI * (s - 0.2) / 0.4);
+                dist = std::min(dist, std::hypot(x - s, z - zs));
+            }
+            EXPECT_LE(std::abs(w->value({x, 0.0, z})), dist + 1e-6) << x << " " << z;
+            EXPECT_LE(w->gradient({x, 0.0, z}).norm(), 1.0 + 1e-12);
+        }
+    // Bounded only above (up = +z).
+    EXPECT_DOUBLE_EQ(w->bounds().max().z(), 0.6);
+    EXPECT_FALSE(std::isfinite(w->bounds().min().z()));
+    EXPECT_THROW(make_wavy_half_space({0, 0, 0}, {0, 0, 1}, {0, 0, 2}, 0.1, 0.4),
+                 std::invalid_argument);
+    EXPECT_THROW(make_wavy_half_space({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, -0.1, 0.4),
+                 std::invalid_argument);
+    EXPECT_THROW(make_wavy_half_space({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, 0.1, 0.0),
+                 std::invalid_argument);
+}
+
+TEST(ImplicitMesher, UnboundedShapeIsRejected) {
+    ImplicitMeshOptions options;
+    options.edge_length = 0.05;
+    EXPECT_THROW(
+        mesh_implicit_shape(*make_wavy_half_space({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, 0.1, 0.4),
+                            options),
+        std::invalid_argument);
+}
+
+TEST(ImplicitMesher, WavySlabIsClosedIntersectionFreeAndFollowsTheCosine) {
+    // A capillary-wave liquid slab: z < h + A cos(2π(x − x0)/λ) cut by a box; two whole
+    // wavelengths across x so the enclosed volume equals the flat slab's.
+    const double h = 0.3, amplitude = 0.04, wavelength = 0.5, x0 = 0.1, xi = 0.025;
+    const Vec3 box_lo(0.1, 0.0, 0.0), box_hi(1.1, 0.4, 0.6);
+    const auto slab = make_intersection(
+        {make_wavy_half_space({x0, 0, h}, {0, 0, 1}, {1, 0, 0}, amplitude, wavelength),
+         make_box(box_lo, box_hi)});
+    ImplicitMeshOptions options;
+    options.edge_length = xi;
+    ImplicitMeshReport report;
+    const SurfaceMesh mesh = mesh_implicit_shape(*slab, options, &report);
+
+    const auto violations = validate_mesh(mesh);
+    EXPECT_TRUE(violations.empty()) << violations.size() << " violations";
+    EXPECT_TRUE(is_intersection_free(mesh));
+    EXPECT_EQ(triangle_components(mesh).count, 1);
+    EXPECT_EQ(euler_characteristic(mesh), 2);
+    EXPECT_GE(report.min_angle_degrees, 10.0);
+    const double exact_volume = (box_hi.x() - box_lo.x()) * (box_hi.y() - box_lo.y()) * h;
+    EXPECT_NEAR(enclosed_volume(mesh), exact_volume, 0.01 * exact_volume);
+
+    // Every vertex off the box's walls lies on the exact cosine, and the top is all there.
+    const double tolerance = 1e-3 * xi;
+    int top_vertices = 0;
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        if (!mesh.vertex_alive(vi))
+            continue;
+        const Vec3& p = mesh.position(vi);
+        const double wall = std::min({p.x() - box_lo.x(), box_hi.x() - p.x(), p.y() - box_lo.y(),
+                                      box_hi.y() - p.y(), p.z() - box_lo.z()});
+        if (wall < tolerance)
+            continue;
+        ++top_vertices;
+        const double z_exact = h + amplitude * std::cos(2 * PI * (p.x() - x0) / wavelength);
+        EXPECT_NEAR(p.z(), z_exact, tolerance) << "vertex " << vi << " at x = " << p.x();
+    }
+    const double top_area = (box_hi.x() - box_lo.x()) * (box_hi.y() - box_lo.y());
+    EXPECT_GT(top_vertices, 0.7 * top_area / (std::sqrt(3.0) / 2.0 * xi * xi));
 }
 
 TEST(ImplicitShapes, RejectBadParameters) {
