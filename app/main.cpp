@@ -108,6 +108,13 @@ int command_run(const std::vector<std::string>& args) {
                      result.simulated_time, result.frames_written - 1, options.out_dir.c_str());
         return EXIT_INTERRUPTED;
     }
+    if (result.stalled) {
+        std::fprintf(stderr,
+                     "meniscus: the flow stalled at t = %g s (steps advanced no time); frames "
+                     "0..%d in %s are complete\n",
+                     result.simulated_time, result.frames_written - 1, options.out_dir.c_str());
+        return EXIT_INTERNAL;
+    }
     if (!options.quiet)
         std::fprintf(stderr, "meniscus: wrote %d frames (%lld steps) to %s\n",
                      result.frames_written, result.steps, options.out_dir.c_str());

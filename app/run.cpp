@@ -3,6 +3,9 @@
 #include "app/progress.h"
 #include "coupling/simulation.h"
 #include "coupling/vdb_output.h"
+#include "tracker/flows/curl_noise.h"
+#include "tracker/flows/flow_errors.h"
+#include "tracker/flows/flow_runner.h"
 #include "tracker/flows/velocity_field.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/mesh_intersections.h"
@@ -13,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -33,6 +37,12 @@ using Clock = std::chrono::steady_clock;
 constexpr size_t MAX_LISTED_VIOLATIONS = 5;
 /// Frames are numbered with this many digits.
 constexpr int FRAME_DIGITS = 4;
+/// Geometric flows: a step that ends this close (fraction of /time/dt) to a stop lands on it.
+constexpr double TIME_SNAP_FRACTION = 1e-9;
+/// Geometric flows: the run stops (RunResult::stalled) after this many consecutive steps that
+/// advance less than STALL_FRACTION of the offered step.
+constexpr int MAX_STALLED_STEPS = 50;
+constexpr double STALL_FRACTION = 1e-6;
 
 double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -44,12 +54,113 @@ std::string frame_path(const std::string& dir, const char* stem, int frame, cons
     return (std::filesystem::path(dir) / name).string();
 }
 
-std::unique_ptr<tracker::VelocityField> make_field(const FlowOptions& flow) {
+/// A geometric flow (paper §4) ready to step: the stepper owns its step control; `field` keeps
+/// the velocity field a VelocityFieldStepper points to alive. No stepper for "none".
+struct GeometricFlow {
+    std::unique_ptr<tracker::VelocityField> field;
+    std::unique_ptr<tracker::FlowStepper> stepper;
+    std::vector<double> breakpoints;  ///< times steps must end on (speed discontinuities)
+};
+
+GeometricFlow make_flow(const FlowOptions& flow) {
     // "fluid" scenes never get here (run_fluid_scene).
-    if (flow.type == "enright")
-        return std::make_unique<tracker::EnrightField>(flow.period);
-    return nullptr;  // "none": the surface stays where it is
+    GeometricFlow g;
+    if (flow.type == "enright" || flow.type == "curl_noise") {
+        if (flow.type == "enright")
+            g.field = std::make_unique<tracker::EnrightField>(flow.period);
+        else
+            g.field = std::make_unique<tracker::CurlNoiseField>(flow.curl_noise);
+        g.stepper = std::make_unique<tracker::VelocityFieldStepper>(*g.field);
+    } else if (flow.type == "normal_speed") {
+        const NormalSpeedOptions& n = flow.normal_speed;
+        const double speed = n.speed, reversal = n.reversal_time;
+        const tracker::NormalSpeed normal_speed = [speed, reversal](double t) {
+            return reversal > 0.0 && t >= reversal ? -speed : speed;
+        };
+        if (n.method == "face_offsetting")
+            g.stepper = std::make_unique<tracker::FaceOffsettingStepper>(
+                normal_speed, n.face_offsetting, n.inversion);
+        else
+            g.stepper = std::make_unique<tracker::VertexNormalStepper>(normal_speed, n.inversion);
+        if (reversal > 0.0)
+            g.breakpoints.push_back(reversal);
+    } else if (flow.type == "mean_curvature") {
+        g.stepper = std::make_unique<tracker::MeanCurvatureStepper>(flow.mean_curvature);
+    }
+    return g;
 }
+
+/// /flow/exact: the error of the surface against an exact solution, per frame.
+class ExactSolution {
+public:
+    /// `end_time`: the run's last frame time (a never-reversing A1 speed grows until then).
+    ExactSolution(const Scene& scene, double end_time)
+        : m_options(scene.flow.exact),
+          m_two_spheres(two_sphere_normal_flow(scene, end_time)),
+          m_source(scene.source_path) {}
+
+    bool enabled() const { return m_options.type != "none"; }
+
+    /// Throws InputError unless the initial surface is the exact solution at t = 0: every vertex
+    /// within INITIAL_VERTEX_TOLERANCE · ξ of it and the enclosed volume within
+    /// INITIAL_VOLUME_TOLERANCE of the exact one (so that, say, one sphere of the two fails).
+    void check_initial(const SurfaceMesh& mesh, double xi) const {
+        const tracker::SurfaceError e = error(mesh, 0.0);
+        const double volume = tracker::enclosed_volume(mesh), exact = initial_volume();
+        if (e.vertex_linf <= INITIAL_VERTEX_TOLERANCE * xi &&
+            std::abs(volume - exact) <= INITIAL_VOLUME_TOLERANCE * exact)
+            return;
+        std::ostringstream s;
+        s << m_source << ": /flow/exact: the initial surface is not the exact "
+          << m_options.type << " solution at t = 0 (vertices up to " << e.vertex_linf
+          << " m off it, allowed " << INITIAL_VERTEX_TOLERANCE * xi << "; volume " << volume
+          << " m³, exact " << exact << "): make /surface/shape the same sphere(s)";
+        throw InputError(s.str());
+    }
+
+    /// The stats.jsonl entry at time t.
+    nlohmann::json stats(const SurfaceMesh& mesh, double t) const {
+        const tracker::SurfaceError e = error(mesh, t);
+        nlohmann::json j = {{"type", m_options.type},
+                            {"linf", e.linf},
+                            {"l1", e.l1},
+                            {"vertex_linf", e.vertex_linf},
+                            {"vertex_l1", e.vertex_l1}};
+        if (m_options.type == "sphere_mean_curvature")
+            j["radius"] = tracker::sphere_mean_curvature_radius(m_options.radius, t);
+        return j;
+    }
+
+private:
+    /// Vertices of the meshed initial shape sit within 1e-3 ξ of it (implicit_mesher).
+    static constexpr double INITIAL_VERTEX_TOLERANCE = 1e-2;
+    /// Relative volume slack: a polyhedron inscribed in a sphere loses about ℓ²/(4R²).
+    static constexpr double INITIAL_VOLUME_TOLERANCE = 0.05;
+
+    tracker::SurfaceError error(const SurfaceMesh& mesh, double t) const {
+        if (m_options.type == "two_sphere_normal_flow")
+            return tracker::two_sphere_normal_flow_error(mesh, m_two_spheres, t,
+                                                         m_options.sampling);
+        return tracker::sphere_error(mesh, m_options.center0,
+                                     tracker::sphere_mean_curvature_radius(m_options.radius, t),
+                                     m_options.sampling);
+    }
+
+    double initial_volume() const {
+        const double r = m_options.radius, ball = 4.0 / 3.0 * M_PI * r * r * r;
+        if (m_options.type != "two_sphere_normal_flow")
+            return ball;
+        const double d = (m_options.center1 - m_options.center0).norm();
+        // Two equal balls overlapping in a lens of volume π(4r + d)(2r − d)²/12.
+        const double lens = d < 2.0 * r ? M_PI * (4.0 * r + d) * (2.0 * r - d) * (2.0 * r - d) / 12.0
+                                        : 0.0;
+        return 2.0 * ball - lens;
+    }
+
+    ExactSolutionOptions m_options;
+    tracker::TwoSphereNormalFlow m_two_spheres;
+    std::string m_source;
+};
 
 /// Per-frame timings (seconds) and collision work, summed over the frame's steps.
 struct FrameWork {
@@ -61,6 +172,7 @@ struct FrameWork {
     long long collisions_found = 0;
     long long impact_zone_iterations = 0;
     long long step_shortenings = 0;
+    long long flow_shortenings = 0;  ///< steps the flow's own limit shortened (inversion, CFL)
     int intersecting_pairs = -1;  ///< worst exact check result of the frame, −1 = not checked
 };
 
@@ -127,6 +239,7 @@ nlohmann::json frame_stats(int frame, double time, double dt, long long steps,
             {"collisions_found", work.collisions_found},
             {"impact_zone_iterations", work.impact_zone_iterations},
             {"step_shortenings", work.step_shortenings},
+            {"flow_step_shortenings", work.flow_shortenings},
             {"intersecting_pairs", work.intersecting_pairs},
             {"seconds",
              {{"improvement", work.improvement},
@@ -378,19 +491,30 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
     // --frames keeps the time per frame of the scene.
     const double frame_dt = scene.time.end / scene.time.frames;
     const double end_time = frame_dt * frames;
-    const auto field = make_field(scene.flow);
+    const GeometricFlow flow = make_flow(scene.flow);
+    const ExactSolution exact(scene, end_time);
+    if (exact.enabled())
+        exact.check_initial(mesh, tracker.characteristic_length());
 
     FrameWriter writer(scene, options.out_dir);
     Progress progress(stderr, options.quiet);
     std::vector<Vec3> velocities(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
+    const auto write_stats = [&](int frame, double t, double dt, long long steps,
+                                 const FrameWork& work) {
+        nlohmann::json line = frame_stats(frame, t, dt, steps, mesh, work);
+        if (exact.enabled())
+            line["exact_error"] = exact.stats(mesh, t);
+        writer.stats(line);
+    };
 
     RunResult result;
     FrameWork work;
     work.output = writer.write(0, mesh, velocities);
-    writer.stats(frame_stats(0, 0.0, 0.0, 0, mesh, work));
+    write_stats(0, 0.0, 0.0, 0, work);
     result.frames_written = 1;
 
     double t = 0.0, dt = 0.0;
+    int stalled = 0;
     for (int frame = 1; frame <= frames; ++frame) {
         const double t_frame = frame == frames ? end_time : frame * frame_dt;
         long long steps = 0;
@@ -398,7 +522,12 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
         while (t < t_frame) {
             if (should_stop(options, stop, t, progress, result))
                 return result;
-            dt = std::min(scene.time.dt, t_frame - t);
+            // Steps end exactly on frame times and on the flow's breakpoints (A1's reversal).
+            double next_stop = t_frame;
+            for (double b : flow.breakpoints)
+                if (b > t && b < next_stop)
+                    next_stop = b;
+            const double offered = std::min(scene.time.dt, next_stop - t);
             auto start = Clock::now();
             tracker.improve();
             work.improvement += seconds_since(start);
@@ -407,10 +536,13 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
             work.topology += seconds_since(start);
             velocities.assign(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
             start = Clock::now();
-            if (field) {
-                const std::vector<Vec3> d = tracker::rk4_displacements(mesh, *field, t, dt);
-                for (size_t vi = 0; vi < d.size(); ++vi)
-                    velocities[vi] = d[vi] / dt;
+            dt = offered;
+            if (flow.stepper) {
+                const tracker::FlowStep step = flow.stepper->step(mesh, t, offered);
+                dt = step.dt;
+                work.flow_shortenings += step.shortened ? 1 : 0;
+                for (size_t vi = 0; vi < step.displacements.size(); ++vi)
+                    velocities[vi] = step.displacements[vi] / dt;
             }
             work.set_velocity += seconds_since(start);
             start = Clock::now();
@@ -422,13 +554,26 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
             work.intersecting_pairs = std::max(work.intersecting_pairs, r.intersecting_pairs);
             result.max_intersecting_pairs =
                 std::max(result.max_intersecting_pairs, r.intersecting_pairs);
-            // Land exactly on the frame time despite round-off in the sum of steps.
-            t = (t_frame - (t + dt) <= 1e-12 * t_frame) ? t_frame : t + dt;
+            // Advance by the motion actually applied; land exactly on the stop despite
+            // round-off in the sum of steps.
+            t += r.time_advanced;
+            if (next_stop - t <= TIME_SNAP_FRACTION * scene.time.dt)
+                t = next_stop;
             ++steps;
             ++result.steps;
+            stalled = r.time_advanced < STALL_FRACTION * offered ? stalled + 1 : 0;
+            if (stalled >= MAX_STALLED_STEPS) {
+                progress.finish();
+                result.stalled = true;
+                result.simulated_time = t;
+                work.output = writer.write(frame, mesh, velocities);
+                write_stats(frame, t, dt, steps, work);
+                result.frames_written = frame + 1;
+                return result;
+            }
         }
         work.output = writer.write(frame, mesh, velocities);
-        writer.stats(frame_stats(frame, t, dt, steps, mesh, work));
+        write_stats(frame, t, dt, steps, work);
         result.frames_written = frame + 1;
         result.simulated_time = t;
         char detail[96];

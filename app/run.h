@@ -29,6 +29,9 @@ struct RunResult {
     int frames_written = 0;  ///< including frame 0
     bool interrupted = false;
     bool reached_max_steps = false;  ///< stopped by RunOptions::max_steps
+    /// A geometric flow stopped because its steps advanced no time (a stalled inversion limit
+    /// or collision resolution); the last frame written is the stalled state.
+    bool stalled = false;
     /// Worst exact self-intersection count over all steps (−1 unless
     /// /tracker/verify_intersection_free is on).
     int max_intersecting_pairs = -1;

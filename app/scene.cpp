@@ -2,7 +2,9 @@
 
 #include "app/json_fields.h"
 
+#include <cstdint>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace meniscus::app {
@@ -12,7 +14,11 @@ namespace {
 using tracker::ShapePtr;
 using Vec3 = Eigen::Vector3d;
 
-const std::vector<std::string> FLOW_TYPES = {"fluid", "enright", "none"};
+const std::vector<std::string> FLOW_TYPES = {"fluid",          "enright",    "normal_speed",
+                                             "mean_curvature", "curl_noise", "none"};
+const std::vector<std::string> NORMAL_SPEED_METHODS = {"face_offsetting", "vertex_normals"};
+const std::vector<std::string> EXACT_TYPES = {"none", "two_sphere_normal_flow",
+                                              "sphere_mean_curvature"};
 
 /// Reads/describes an enum through its names (the first name is used for the reference).
 template <typename V, typename Enum>
@@ -115,12 +121,93 @@ void visit_fields(V& v, SurfaceOptions& o) {
 }
 
 template <typename V>
+void visit_fields(V& v, tracker::FaceOffsettingOptions& o) {
+    enum_field(v, "weighting", o.weighting,
+               {{"area", tracker::OffsetWeighting::area},
+                {"angle", tracker::OffsetWeighting::angle}},
+               "weights of the incident triangle planes: area or interior angle at the vertex");
+    enum_field(v, "expansion", o.expansion,
+               {{"huygens", tracker::ExpansionRule::huygens},
+                {"planes", tracker::ExpansionRule::planes}},
+               "where offset planes diverge: `huygens` (mean offset along the mean normal, the "
+               "exact expansion fan) or `planes` (least-squares plane intersection, Jiao)");
+    v.number("primary_eigenvalue_ratio", o.primary_eigenvalue_ratio, Range{0.0, 1.0, true, true},
+             "", "eigenvalues ≥ this ratio of the largest span the primary space (Jiao's ε)");
+    v.number("null_space_smoothing", o.null_space_smoothing, Range::between(0.0, 1.0), "",
+             "fraction of the tangential (null-space) smoothing move added per step");
+    v.number("max_offset_ratio", o.max_offset_ratio, Range::at_least(1.0), "",
+             "cap on a vertex's offset in units of its largest incident plane offset");
+}
+
+template <typename V>
+void visit_fields(V& v, NormalSpeedOptions& o) {
+    v.choice("method", o.method, NORMAL_SPEED_METHODS,
+             "`face_offsetting` (entropy solution, paper §4.1) or `vertex_normals` (area-weighted "
+             "vertex normals; the paper's non-converging comparison, Fig. 4.2)");
+    v.number("speed", o.speed, Range::any(), "m/s",
+             "normal speed, positive along the outward normal (expands a closed surface)");
+    v.number("reversal_time", o.reversal_time, Range::non_negative(), "s",
+             "the speed flips sign at this time (A1: 1); 0 = never");
+    v.number("min_area_fraction", o.inversion.min_area_fraction, Range{0.0, 1.0, false, true}, "",
+             "steps are shortened so every triangle keeps this fraction of its area along its "
+             "normal (no inversion)");
+    v.section("face_offsetting", "face-offsetting scheme (method face_offsetting)",
+              [&](auto& r) { visit_fields(r, o.face_offsetting); });
+}
+
+template <typename V>
+void visit_fields(V& v, tracker::CurlNoiseOptions& o) {
+    int seed = static_cast<int>(o.seed);
+    v.integer("seed", seed, Range::between(0, std::numeric_limits<int>::max()), "",
+              "pseudorandom seed (the same seed gives the same field on every platform)");
+    o.seed = static_cast<std::uint64_t>(seed);
+    v.boolean("planar", o.planar,
+              "potential (0, 0, φ): motion in planes z = const (paper §4.3's rotation)");
+    v.number("rms_speed", o.rms_speed, Range::positive(), "m/s", "spatial RMS of |u|");
+    v.number("base_wavelength", o.base_wavelength, Range::positive(), "m",
+             "wavelength of the first octave");
+    v.integer("octaves", o.octaves, Range::between(1, 16), "", "octaves of random Fourier modes");
+    v.integer("modes_per_octave", o.modes_per_octave, Range::between(1, 10000), "",
+              "random modes per octave");
+    v.number("lacunarity", o.lacunarity, Range::at_least(1.0), "",
+             "wavelength divisor per octave");
+    v.number("persistence", o.persistence, Range::positive(), "",
+             "velocity amplitude factor per octave");
+    v.number("time_frequency", o.time_frequency, Range::non_negative(), "rad/s",
+             "mode angular frequencies drawn from [−f, f] (0 = steady field)");
+}
+
+template <typename V>
+void visit_fields(V& v, ExactSolutionOptions& o) {
+    v.choice("type", o.type, EXACT_TYPES,
+             "`two_sphere_normal_flow` (A1: needs /flow/type normal_speed with speed > 0) or "
+             "`sphere_mean_curvature` (needs /flow/type mean_curvature); the initial surface must "
+             "be that shape (checked when the run starts)");
+    v.vec3("center0", o.center0, Range::any(), "m", "first sphere's centre (the sphere's centre)");
+    v.vec3("center1", o.center1, Range::any(), "m", "second sphere's centre (two spheres only)");
+    v.number("radius", o.radius, Range::positive(), "m", "initial radius of the sphere(s)");
+    v.integer("triangle_subdivisions", o.sampling.triangle_subdivisions, Range::between(1, 64), "",
+              "m: the error samples m² points per triangle");
+}
+
+template <typename V>
 void visit_fields(V& v, FlowOptions& o) {
     v.choice("type", o.type, FLOW_TYPES,
              "what moves the surface: `fluid` (coupled Navier–Stokes), `enright` (paper §4.3 "
-             "deformation test, RK4), `none`");
+             "deformation test, RK4), `normal_speed` (§4.1), `mean_curvature` (§4.2, CFL-limited "
+             "forward Euler), `curl_noise` (§4.3, RK4), `none`");
     v.number("period", o.period, Range::positive(), "s",
              "Enright period T; the field is modulated by sin(2πt/T)");
+    v.section("normal_speed", "motion in the normal direction (type normal_speed)",
+              [&](auto& r) { visit_fields(r, o.normal_speed); });
+    v.section("mean_curvature", "motion by mean curvature (type mean_curvature)", [&](auto& r) {
+        r.number("cfl_number", o.mean_curvature.cfl_number, Range{0.0, 1.0, true, false}, "",
+                 "forward-Euler step ≤ cfl_number · (shortest edge)², also capped by /time/dt");
+    });
+    v.section("curl_noise", "divergence-free pseudorandom field (type curl_noise)",
+              [&](auto& r) { visit_fields(r, o.curl_noise); });
+    v.section("exact", "exact solution whose error is recorded in stats.jsonl every frame",
+              [&](auto& r) { visit_fields(r, o.exact); });
 }
 
 template <typename V>
@@ -482,6 +569,62 @@ std::vector<VelocityRegion> parse_velocity_regions(const nlohmann::json& j) {
     return regions;
 }
 
+/// Calls options.validate(), prefixing its field error with `path`.
+template <typename Options>
+void validate_at(const Options& options, const std::string& path) {
+    try {
+        options.validate();
+    } catch (const std::invalid_argument& e) {
+        throw SceneError(path + e.what());
+    }
+}
+
+/// Cross-field checks of /flow: each flow's section only with its type, the exact solution
+/// only with the flow it solves and within its time of validity.
+void validate_flow(const Scene& scene, const nlohmann::json& j) {
+    const FlowOptions& f = scene.flow;
+    const nlohmann::json* flow = j.contains("flow") ? &j.at("flow") : nullptr;
+    for (const char* section : {"normal_speed", "mean_curvature", "curl_noise"})
+        if (flow && flow->contains(section) && f.type != section)
+            throw SceneError(std::string("/flow/") + section + ": given, but /flow/type is \"" +
+                             f.type + "\"");
+    validate_at(f.normal_speed.face_offsetting, "/flow/normal_speed/face_offsetting/");
+    validate_at(f.normal_speed.inversion, "/flow/normal_speed/");
+    validate_at(f.mean_curvature, "/flow/mean_curvature/");
+    validate_at(f.curl_noise, "/flow/curl_noise/");
+    validate_at(f.exact.sampling, "/flow/exact/");
+    const ExactSolutionOptions& e = f.exact;
+    if (e.type == "none") {
+        if (flow && flow->contains("exact") && flow->at("exact").is_object())
+            for (const auto& item : flow->at("exact").items())
+                if (item.key() != "type")
+                    throw SceneError("/flow/exact/" + item.key() +
+                                     ": given, but /flow/exact/type is \"none\"");
+        return;
+    }
+    if (e.type == "two_sphere_normal_flow") {
+        if (f.type != "normal_speed" || !(f.normal_speed.speed > 0.0))
+            throw SceneError(
+                "/flow/exact/type: two_sphere_normal_flow solves /flow/type normal_speed with "
+                "/flow/normal_speed/speed > 0 (outward first)");
+        if ((e.center1 - e.center0).norm() == 0.0)
+            throw SceneError("/flow/exact/center1: must differ from center0");
+        tracker::TwoSphereNormalFlow exact = two_sphere_normal_flow(scene, scene.time.end);
+        try {
+            exact.signed_distance(e.center0, scene.time.end);
+        } catch (const std::invalid_argument&) {
+            throw SceneError("/time/end: past the time the exact two-sphere surface vanishes");
+        }
+        return;
+    }
+    // sphere_mean_curvature
+    if (f.type != "mean_curvature")
+        throw SceneError("/flow/exact/type: sphere_mean_curvature solves /flow/type mean_curvature");
+    if (!(scene.time.end < 0.25 * e.radius * e.radius))
+        throw SceneError("/time/end: must be before the sphere's extinction time R0²/4 = " +
+                         std::to_string(0.25 * e.radius * e.radius) + " s");
+}
+
 std::string read_file(const std::string& path) {
     std::ifstream in(path);
     if (!in)
@@ -520,6 +663,7 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
         if (scene.flow.type == "fluid" && scene.coupling.edge_length_cells > 0.0)
             scene.surface.edge_length =
                 scene.coupling.edge_length_cells * scene.domain.size.x() / scene.domain.cells;
+        validate_flow(scene, j);
         try {
             scene.tracker.validate();
         } catch (const std::invalid_argument& e) {
@@ -536,6 +680,19 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
     } catch (const SceneError& e) {
         throw SceneError(source + ": " + e.what());
     }
+}
+
+tracker::TwoSphereNormalFlow two_sphere_normal_flow(const Scene& scene, double end_time) {
+    tracker::TwoSphereNormalFlow exact;
+    exact.center0 = scene.flow.exact.center0;
+    exact.center1 = scene.flow.exact.center1;
+    exact.initial_radius = scene.flow.exact.radius;
+    exact.speed = scene.flow.normal_speed.speed;
+    // A speed that never reverses: the balls grow for the whole run.
+    exact.reversal_time = scene.flow.normal_speed.reversal_time > 0.0
+                              ? scene.flow.normal_speed.reversal_time
+                              : end_time;
+    return exact;
 }
 
 Scene load_scene(const std::string& path) {

@@ -4,6 +4,10 @@
 
 #include "coupling/simulation.h"
 #include "fluid/fluid_solver.h"
+#include "tracker/flows/curl_noise.h"
+#include "tracker/flows/face_offsetting.h"
+#include "tracker/flows/flow_errors.h"
+#include "tracker/flows/mean_curvature.h"
 #include "tracker/implicit_shape.h"
 #include "tracker/surface_tracker.h"
 
@@ -23,12 +27,45 @@ struct SurfaceOptions {
     std::string inside = "liquid";
 };
 
-/// The motion that drives the surface until the fluid solver lands (paper §4 test modes).
+/// Motion in the normal direction (paper §4.1, VALIDATION.md A1).
+struct NormalSpeedOptions {
+    /// "face_offsetting" (Jiao's entropy-satisfying scheme) or "vertex_normals" (area-weighted
+    /// vertex normals; the paper's non-converging comparison).
+    std::string method = "face_offsetting";
+    double speed = 0.2;  ///< along the outward normal (m/s; negative shrinks)
+    /// The speed flips sign at this time (s): +speed before, −speed from then on (A1: 1 s).
+    /// 0 = never reverses.
+    double reversal_time = 0.0;
+    tracker::FaceOffsettingOptions face_offsetting;  ///< used by method face_offsetting
+    tracker::InversionLimitOptions inversion;        ///< step limit of both methods
+};
+
+/// An exact solution to measure the surface against at every frame (VALIDATION.md A1, A2).
+struct ExactSolutionOptions {
+    /// "none", "two_sphere_normal_flow" (A1: two balls of `radius` around `center0`/`center1`
+    /// under /flow/normal_speed with speed > 0; the exact entropy solution of
+    /// tracker::TwoSphereNormalFlow) or "sphere_mean_curvature" (a ball of `radius` around
+    /// `center0` under mean-curvature flow: R(t) = sqrt(R₀² − 4t)).
+    std::string type = "none";
+    Eigen::Vector3d center0 = Eigen::Vector3d(-0.25, 0.0, 0.0);  ///< m
+    Eigen::Vector3d center1 = Eigen::Vector3d(0.25, 0.0, 0.0);   ///< m (two spheres only)
+    double radius = 0.2;                                         ///< initial radius (m)
+    /// Surface error sampling (tracker::surface_error): m² samples per triangle.
+    tracker::SurfaceErrorOptions sampling;
+};
+
+/// The motion that drives the surface: the coupled fluid or one of the paper's geometric flows
+/// (§4).
 struct FlowOptions {
-    /// "fluid" (the coupled Navier–Stokes solver moves the surface), "enright" (paper §4.3)
-    /// or "none" (the surface stays still).
+    /// "fluid" (the coupled Navier–Stokes solver moves the surface), "enright" (paper §4.3),
+    /// "normal_speed" (§4.1), "mean_curvature" (§4.2), "curl_noise" (§4.3) or "none" (the
+    /// surface stays still).
     std::string type = "enright";
     double period = 3.0;  ///< Enright period T: velocity modulated by sin(2πt/T) (s)
+    NormalSpeedOptions normal_speed;
+    tracker::MeanCurvatureFlowOptions mean_curvature;
+    tracker::CurlNoiseOptions curl_noise;
+    ExactSolutionOptions exact;
 };
 
 /// The fluid's box: cubic cells, `cells` of them along x.
@@ -93,6 +130,10 @@ Scene load_scene(const std::string& path);
 /// Parses a scene from JSON text; `source` names it in errors, `base_dir` resolves mesh_file.
 Scene parse_scene(const std::string& json_text, const std::string& source,
                   const std::string& base_dir);
+/// The A1 exact solution a scene with /flow/exact/type two_sphere_normal_flow describes: its
+/// spheres, /flow/normal_speed/speed, and the reversal time (`end_time` when the speed never
+/// reverses, so the balls grow throughout a run ending then).
+tracker::TwoSphereNormalFlow two_sphere_normal_flow(const Scene& scene, double end_time);
 /// Markdown reference of every scene key: type, default, unit, meaning.
 std::string scene_reference_markdown();
 

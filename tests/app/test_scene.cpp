@@ -77,9 +77,73 @@ TEST(Scene, ErrorsNameTheJsonPath) {
                   .find("/time/frames: expected an integer"),
               std::string::npos);
     EXPECT_NE(error_of(R"({"flow": {"type": "wind"}, "surface": {"shape": {"type": "sphere"}}})")
-                  .find("/flow/type: expected one of \"fluid\", \"enright\", \"none\", got \"wind\""),
+                  .find("/flow/type: expected one of \"fluid\", \"enright\", \"normal_speed\", "
+                        "\"mean_curvature\", \"curl_noise\", \"none\", got \"wind\""),
               std::string::npos);
     EXPECT_NE(error_of("[1, 2]").find("/: expected an object"), std::string::npos);
+}
+
+TEST(Scene, GeometricFlowKeys) {
+    const Scene s = parse_scene(R"({"surface": {"shape": {"type": "sphere"}},
+        "flow": {"type": "normal_speed", "normal_speed": {"method": "vertex_normals",
+                 "speed": -0.1, "reversal_time": 0.5, "min_area_fraction": 0.2,
+                 "face_offsetting": {"expansion": "planes", "max_offset_ratio": 2}}}})",
+                                "t.json", ".");
+    EXPECT_EQ(s.flow.normal_speed.method, "vertex_normals");
+    EXPECT_EQ(s.flow.normal_speed.speed, -0.1);
+    EXPECT_EQ(s.flow.normal_speed.reversal_time, 0.5);
+    EXPECT_EQ(s.flow.normal_speed.inversion.min_area_fraction, 0.2);
+    EXPECT_EQ(s.flow.normal_speed.face_offsetting.expansion, tracker::ExpansionRule::planes);
+    EXPECT_EQ(s.flow.normal_speed.face_offsetting.max_offset_ratio, 2.0);
+    const Scene c = parse_scene(R"({"surface": {"shape": {"type": "sphere"}},
+        "flow": {"type": "curl_noise", "curl_noise": {"seed": 7, "planar": true,
+                 "rms_speed": 0.3, "time_frequency": 2}}})",
+                                "t.json", ".");
+    EXPECT_EQ(c.flow.curl_noise.seed, 7u);
+    EXPECT_TRUE(c.flow.curl_noise.planar);
+    EXPECT_EQ(c.flow.curl_noise.rms_speed, 0.3);
+    EXPECT_EQ(c.flow.curl_noise.time_frequency, 2.0);
+    EXPECT_EQ(c.flow.curl_noise.octaves, tracker::CurlNoiseOptions{}.octaves);
+}
+
+TEST(Scene, GeometricFlowErrorsNameTheJsonPath) {
+    const std::string sphere = R"("surface": {"shape": {"type": "sphere"}})";
+    const auto error_with = [&](const std::string& rest) {
+        return error_of("{" + sphere + ", " + rest + "}");
+    };
+    EXPECT_NE(error_with(R"("flow": {"type": "normal_speed", "normal_speed": {"method": "levelset"}})")
+                  .find("/flow/normal_speed/method: expected one of"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "normal_speed", "normal_speed": {"face_offsetting": {"max_offset_ratio": 0.5}}})")
+                  .find("/flow/normal_speed/face_offsetting/max_offset_ratio: expected a number >= 1"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "mean_curvature", "mean_curvature": {"cfl_number": 0}})")
+                  .find("/flow/mean_curvature/cfl_number: expected a number in (0, 1]"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "curl_noise", "curl_noise": {"seed": -1}})")
+                  .find("/flow/curl_noise/seed: expected an integer"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "enright", "curl_noise": {"planar": true}})")
+                  .find("/flow/curl_noise: given, but /flow/type is \"enright\""),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "mean_curvature", "exact": {"type": "two_sphere_normal_flow"}})")
+                  .find("/flow/exact/type: two_sphere_normal_flow solves /flow/type normal_speed"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "normal_speed", "normal_speed": {"speed": -0.2}, "exact": {"type": "two_sphere_normal_flow"}})")
+                  .find("/flow/exact/type: two_sphere_normal_flow solves"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "normal_speed", "exact": {"type": "sphere_mean_curvature"}})")
+                  .find("/flow/exact/type: sphere_mean_curvature solves /flow/type mean_curvature"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "mean_curvature", "exact": {"type": "sphere_mean_curvature", "radius": 0.2}}, "time": {"end": 0.02})")
+                  .find("/time/end: must be before the sphere's extinction time"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "normal_speed", "exact": {"radius": 0.3}})")
+                  .find("/flow/exact/radius: given, but /flow/exact/type is \"none\""),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "normal_speed", "normal_speed": {"reversal_time": 1}, "exact": {"type": "two_sphere_normal_flow"}}, "time": {"end": 5})")
+                  .find("/time/end: past the time the exact two-sphere surface vanishes"),
+              std::string::npos);
 }
 
 TEST(Scene, WavyHalfSpaceSlab) {
