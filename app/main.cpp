@@ -5,6 +5,7 @@
 #include "app/run.h"
 #include "app/scene.h"
 #include "app/validate.h"
+#include "app/validate_fluid.h"
 
 #include <atomic>
 #include <csignal>
@@ -41,7 +42,7 @@ const char* USAGE =
     "        (keeping its time per frame); --max-steps N stops after N time steps (smoke tests).\n"
     "        Ctrl-C stops after the current step; every file\n"
     "        already written is complete.\n"
-    "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4]...\n"
+    "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4|B1|B2|B3|B4|B5]...\n"
     "        run the paper's geometric-flow validation cases (quick: coarse, minutes; full: the\n"
     "        paper's resolutions, hours) and write report.md, results.json and plots into DIR\n"
     "        (default: validation/); --case runs only the named cases (repeatable); exit code 1\n"
@@ -147,8 +148,9 @@ int dispatch(int argc, char** argv) {
                 options.out_dir = args[++i];
             else if (args[i] == "--case" && i + 1 < args.size()) {
                 const std::string id = args[++i];
-                if (id != "A1" && id != "A2" && id != "A3" && id != "A4")
-                    throw UsageError("validate: --case expects A1, A2, A3 or A4, got '" + id + "'");
+                if (id != "A1" && id != "A2" && id != "A3" && id != "A4" && !is_fluid_case(id))
+                    throw UsageError("validate: --case expects A1, A2, A3, A4 or B1 … B5, got '" +
+                                     id + "'");
                 options.cases.push_back(id);
             } else
                 throw UsageError("validate: unknown or incomplete option " + args[i]);

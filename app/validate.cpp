@@ -5,6 +5,7 @@
 
 #include "app/validate.h"
 
+#include "app/validate_fluid.h"
 #include "tracker/flows/curl_noise.h"
 #include "tracker/flows/flow_errors.h"
 #include "tracker/flows/flow_runner.h"
@@ -863,10 +864,15 @@ int run_validation(const ValidateOptions& options) {
         return options.cases.empty() ||
                std::find(options.cases.begin(), options.cases.end(), id) != options.cases.end();
     };
-    for (const std::string& id : options.cases)
-        if (id != "A1" && id != "A2" && id != "A3" && id != "A4")
+    std::vector<std::string> fluid_cases;  // part B (app/validate_fluid.h)
+    for (const std::string& id : options.cases) {
+        if (is_fluid_case(id))
+            fluid_cases.push_back(id);
+        else if (id != "A1" && id != "A2" && id != "A3" && id != "A4")
             throw std::invalid_argument("validate: unknown case '" + id +
-                                        "' (expected A1, A2, A3 or A4)");
+                                        "' (expected A1, A2, A3, A4 or B1 … B5)");
+    }
+    const bool any_fluid_case = options.cases.empty() || !fluid_cases.empty();
     if (wanted("A1"))
         case_a1(c);
     if (wanted("A2"))
@@ -875,6 +881,12 @@ int run_validation(const ValidateOptions& options) {
         case_a3(c);
     if (wanted("A4"))
         case_a4(c);
+    FluidValidation part_b;
+    if (any_fluid_case) {
+        part_b = run_fluid_validation({options.full, options.quiet, fluid_cases, out});
+        c.all_ok = c.all_ok && part_b.all_ok;
+        c.failures.insert(c.failures.end(), part_b.failures.begin(), part_b.failures.end());
+    }
 
     Json results;
     results["mode"] = options.full ? "full" : "quick";
@@ -901,6 +913,10 @@ int run_validation(const ValidateOptions& options) {
     report_a2(body, results);
     report_a3(body, results);
     report_a4(body, results);
+    if (any_fluid_case) {
+        results["part_b"] = part_b.results;
+        body << part_b.report;
+    }
     results["all_ok"] = c.all_ok;
     results["failures"] = c.failures;
     results["wall_seconds"] = seconds_since(wall_start);
@@ -910,7 +926,8 @@ int run_validation(const ValidateOptions& options) {
             throw std::runtime_error("cannot write " + (out / "results.json").string());
         f << results.dump(1) << "\n";
     }
-    const std::string plot_note = make_plots(out);
+    const std::string plot_note =
+        make_plots(out) + (any_fluid_case ? " " + make_fluid_plots(out) : std::string());
     md << "**Status: "
        << (c.all_ok ? "all runs finished, no intersections with safety on" : "FAILURES") << "**";
     for (const std::string& f : c.failures)

@@ -18,7 +18,8 @@ struct ValidateOptions {
     bool full = false;
     std::string out_dir = "validation";  ///< folder for report.md, results.json and plots
     bool quiet = false;                  ///< no progress lines on stderr
-    /// Cases to run ("A1", "A2", "A3", "A4"; A5 is timed on the A1 runs); empty: all.
+    /// Cases to run ("A1", "A2", "A3", "A4"; A5 is timed on the A1 runs; "B1" … "B5": part B,
+    /// two-phase flow, app/validate_fluid.h); empty: all.
     std::vector<std::string> cases;
 };
 
