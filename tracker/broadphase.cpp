@@ -15,8 +15,9 @@ namespace {
 
 /// Boxes covering more cells than this are kept in a list checked on every query instead.
 constexpr long long MAX_CELLS_PER_BOX = 512;
-/// Grain of parallel pair enumeration.
+/// Grain of parallel pair enumeration (elements, or grid cells for self joins).
 constexpr size_t PARALLEL_GRAIN = 256;
+constexpr size_t SELF_JOIN_GRAIN = 64;
 
 bool overlaps(const Box3d& a, const Box3d& b) {
     return (a.min().array() <= b.max().array()).all() && (b.min().array() <= a.max().array()).all();
@@ -217,6 +218,22 @@ namespace {
 /// Loose-grid cell size as a multiple of the mean box extent: elements up to one cell wide sit
 /// in one cell; bigger ones go to the oversized list.
 constexpr double LOOSE_CELL_FACTOR = 2.0;
+/// Elements wider than (1 − this) cells count as oversized. The margin makes the neighbour
+/// argument survive the rounding of min/cell: two overlapping elements of at most that width
+/// have computed cells at most one apart on every axis (the relative rounding of a quotient is
+/// 2⁻⁵³, times at most 2²¹ cells from the origin, is far below this margin).
+constexpr double LOOSE_WIDTH_MARGIN = 1e-6;
+/// Half of the 26 neighbour offsets: the ones lexicographically after (0, 0, 0).
+constexpr int HALF_STENCIL[13][3] = {{0, 0, 1},  {0, 1, -1},  {0, 1, 0},  {0, 1, 1},  {1, -1, -1},
+                                     {1, -1, 0}, {1, -1, 1},  {1, 0, -1}, {1, 0, 0},  {1, 0, 1},
+                                     {1, 1, -1}, {1, 1, 0},   {1, 1, 1}};
+
+/// Closed-box overlap on raw coordinates (the hot loop of the pair enumeration).
+inline bool boxes_overlap(const Box3d& a, const Box3d& b) {
+    return a.min().x() <= b.max().x() && b.min().x() <= a.max().x() &&
+           a.min().y() <= b.max().y() && b.min().y() <= a.max().y() &&
+           a.min().z() <= b.max().z() && b.min().z() <= a.max().z();
+}
 
 std::uint64_t mix(std::int64_t key) {
     std::uint64_t x = static_cast<std::uint64_t>(key);
@@ -254,7 +271,8 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
         if (b.isEmpty())
             continue;
         const Eigen::Array3d lo = (b.min().array() / m_cell).floor();
-        if (b.sizes().maxCoeff() > m_cell || (lo.abs() > limit).any() || !lo.allFinite()) {
+        if (b.sizes().maxCoeff() > (1.0 - LOOSE_WIDTH_MARGIN) * m_cell || (lo.abs() > limit).any() ||
+            !lo.allFinite()) {
             m_oversized.push_back(static_cast<int>(i));
             continue;
         }
@@ -282,7 +300,59 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
             slot = (slot + 1) & (slots - 1);
         m_slot_key[slot] = keyed[i].first;
         m_slot_range[slot] = {static_cast<int>(i), static_cast<int>(j)};
+        const Eigen::Array3d lo =
+            (boxes[static_cast<size_t>(keyed[i].second)].min().array() / m_cell).floor();
+        m_cells.push_back({lo.cast<int>(), static_cast<int>(i), static_cast<int>(j)});
         i = j;
+    }
+}
+
+std::pair<int, int> LooseGrid::find_cell(std::int64_t key) const {
+    const size_t mask = m_slot_key.size() - 1;
+    size_t slot = mix(key) & mask;
+    while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
+        slot = (slot + 1) & mask;
+    return m_slot_key[slot] == -1 ? std::pair<int, int>{0, 0} : m_slot_range[slot];
+}
+
+template <typename F>
+void LooseGrid::visit(size_t task, F&& f) const {
+    if (task < m_cells.size()) {
+        const Cell& cell = m_cells[task];
+        for (int a = cell.begin; a < cell.end; ++a) {
+            const int ia = m_ids[static_cast<size_t>(a)];
+            const Box3d& box_a = m_boxes[static_cast<size_t>(ia)];
+            for (int b = a + 1; b < cell.end; ++b) {
+                const int ib = m_ids[static_cast<size_t>(b)];
+                if (boxes_overlap(box_a, m_boxes[static_cast<size_t>(ib)]))
+                    f(ia, ib);
+            }
+        }
+        for (const auto& offset : HALF_STENCIL) {
+            const auto [begin, end] = find_cell(
+                cell_key(cell.coords + Eigen::Array3i(offset[0], offset[1], offset[2])));
+            for (int b = begin; b < end; ++b) {
+                const int ib = m_ids[static_cast<size_t>(b)];
+                const Box3d& box_b = m_boxes[static_cast<size_t>(ib)];
+                for (int a = cell.begin; a < cell.end; ++a) {
+                    const int ia = m_ids[static_cast<size_t>(a)];
+                    if (boxes_overlap(m_boxes[static_cast<size_t>(ia)], box_b))
+                        f(ia, ib);
+                }
+            }
+        }
+        return;
+    }
+    // An oversized element against every other element (two oversized ones once).
+    const int io = m_oversized[task - m_cells.size()];
+    const Box3d& box_o = m_boxes[static_cast<size_t>(io)];
+    for (size_t j = 0; j < m_boxes.size(); ++j) {
+        const int ij = static_cast<int>(j);
+        if (ij == io || m_boxes[j].isEmpty() || !boxes_overlap(box_o, m_boxes[j]))
+            continue;
+        if (ij < io && std::binary_search(m_oversized.begin(), m_oversized.end(), ij))
+            continue;
+        f(io, ij);
     }
 }
 
@@ -339,6 +409,24 @@ std::vector<Box3d> boxes_of(int count, MakeBox&& make) {
     return boxes;
 }
 
+/// Every overlapping pair of `grid`, through `emit(i, j, out)` (i, j unordered), in parallel over
+/// the grid's tasks; sorted, so the result does not depend on the threading.
+template <typename Pair, typename Emit>
+std::vector<Pair> self_join(const LooseGrid& grid, Emit&& emit) {
+    tbb::enumerable_thread_specific<std::vector<Pair>> local;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.num_tasks(), SELF_JOIN_GRAIN),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          auto& out = local.local();
+                          for (size_t task = r.begin(); task < r.end(); ++task)
+                              grid.visit(task, [&](int i, int j) { emit(i, j, out); });
+                      });
+    std::vector<Pair> all;
+    for (auto& part : local)
+        all.insert(all.end(), part.begin(), part.end());
+    std::sort(all.begin(), all.end());
+    return all;
+}
+
 }  // namespace
 
 BroadPhase::BroadPhase(const SurfaceMesh& mesh, double padding)
@@ -383,29 +471,16 @@ std::vector<VertexTrianglePair> BroadPhase::vertex_triangle_pairs() const {
 }
 
 std::vector<EdgeEdgePair> BroadPhase::edge_edge_pairs() const {
-    return collect_parallel<EdgeEdgePair>(
-        m_edge_boxes.size(),
-        [&](int ei, std::vector<int>& scratch, std::vector<EdgeEdgePair>& out) {
-            if (!m_edges.contains(ei))
-                return;
-            m_edges.query(m_edges.box(ei), scratch);
-            for (int ej : scratch)
-                if (ej > ei && !shares_vertex(m_mesh.edge(ei), m_mesh.edge(ej)))
-                    out.push_back({ei, ej});
-        });
+    return self_join<EdgeEdgePair>(m_edges, [&](int ei, int ej, std::vector<EdgeEdgePair>& out) {
+        if (!shares_vertex(m_mesh.edge(ei), m_mesh.edge(ej)))
+            out.push_back({std::min(ei, ej), std::max(ei, ej)});
+    });
 }
 
 std::vector<TrianglePair> BroadPhase::triangle_pairs() const {
-    return collect_parallel<TrianglePair>(
-        m_triangle_boxes.size(),
-        [&](int ti, std::vector<int>& scratch, std::vector<TrianglePair>& out) {
-            if (!m_triangles.contains(ti))
-                return;
-            m_triangles.query(m_triangles.box(ti), scratch);
-            for (int tj : scratch)
-                if (tj > ti)
-                    out.push_back({ti, tj});
-        });
+    return self_join<TrianglePair>(m_triangles, [](int ti, int tj, std::vector<TrianglePair>& out) {
+        out.push_back({std::min(ti, tj), std::max(ti, tj)});
+    });
 }
 
 std::vector<VertexTrianglePair> brute_force_vertex_triangle_pairs(const SurfaceMesh& mesh,

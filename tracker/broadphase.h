@@ -103,13 +103,29 @@ public:
     const Box3d& box(int id) const { return m_boxes[static_cast<size_t>(id)]; }
     bool contains(int id) const { return !m_boxes[static_cast<size_t>(id)].isEmpty(); }
 
+    /// Every unordered pair of stored elements whose boxes overlap, each visited exactly once,
+    /// grouped into `num_tasks()` independent tasks (for parallel loops): `visit(task, f)` calls
+    /// f(i, j) for the pairs of task `task`. Cell by cell with a half stencil — each cell
+    /// against itself and 13 of its 26 neighbours — so a pair is found once instead of twice
+    /// and the hash is probed once per cell instead of once per element.
+    size_t num_tasks() const { return m_cells.size() + m_oversized.size(); }
+    template <typename F>
+    void visit(size_t task, F&& f) const;
+
 private:
+    struct Cell {
+        Eigen::Array3i coords;
+        int begin, end;  // [begin, end) into m_ids
+    };
     std::int64_t cell_key(const Eigen::Array3i& c) const;
+    /// Range of ids in the cell with `key` ({0, 0} when empty).
+    std::pair<int, int> find_cell(std::int64_t key) const;
     const std::vector<Box3d>& m_boxes;
     double m_cell = 1.0;
     std::vector<int> m_ids;                         // ids grouped by cell
     std::vector<std::int64_t> m_slot_key;           // flat hash: key per slot (−1 = empty)
     std::vector<std::pair<int, int>> m_slot_range;  // [begin, end) into m_ids per slot
+    std::vector<Cell> m_cells;                      // occupied cells in key order
     std::vector<int> m_oversized;
 };
 
