@@ -297,10 +297,12 @@ static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::strin
     } catch (const std::runtime_error& e) {
         throw InputError(e.what());
     }
-    const auto violations = tracker::validate_mesh(mesh);
+    tracker::ValidationOptions validation;
+    validation.allow_boundary = scene.surface.open;
+    const auto violations = tracker::validate_mesh(mesh, validation);
     if (!violations.empty()) {
         std::ostringstream s;
-        s << file << ": not a valid closed surface (" << violations.size() << " problems):";
+        s << file << ": not a valid " << (scene.surface.open ? "open" : "closed") << " surface (" << violations.size() << " problems):";
         for (size_t i = 0; i < violations.size() && i < MAX_LISTED_VIOLATIONS; ++i)
             s << "\n  " << tracker::to_string(violations[i].kind) << ": " << violations[i].message;
         if (violations.size() > MAX_LISTED_VIOLATIONS)
@@ -522,8 +524,9 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
         while (t < t_frame) {
             if (should_stop(options, stop, t, progress, result))
                 return result;
-            // Steps end exactly on frame times and on the flow's breakpoints (A1's reversal).
-            double next_stop = t_frame;
+            // Steps end exactly on frame times (unless /time/land_on_frames is off: then on the
+            // end time only) and on the flow's breakpoints (A1's reversal).
+            double next_stop = scene.time.land_on_frames ? t_frame : end_time;
             for (double b : flow.breakpoints)
                 if (b > t && b < next_stop)
                     next_stop = b;

@@ -115,6 +115,9 @@ void visit_fields(V& v, SurfaceOptions& o) {
            "closed, consistently oriented, no degenerate or duplicate triangles");
     v.integer("remesh_iterations", o.remesh_iterations, Range::between(0, 100), "",
               "isotropic remeshing passes after marching tetrahedra");
+    v.boolean("open", o.open,
+              "the mesh_file is an open surface with boundary edges (paper §4.4; geometric flows "
+              "only): boundary edges are never split, flipped, collapsed or merged");
     v.choice("inside", o.inside, {"liquid", "gas"},
              "phase enclosed by the surface: `liquid` (drops, pools) or `gas` (bubbles; the "
              "liquid fills everything outside)");
@@ -217,6 +220,10 @@ void visit_fields(V& v, TimeOptions& o) {
               "frames after the initial one, evenly spaced in time");
     v.number("dt", o.dt, Range::positive(), "s",
              "maximum time step (shortened to land exactly on frame times)");
+    v.boolean("land_on_frames", o.land_on_frames,
+              "shorten steps to end exactly on frame times; false (geometric flows only): a frame "
+              "is written after the first step that reaches its time, so the steps are those of "
+              "`meniscus validate` (the end time is still hit exactly)");
 }
 
 template <typename V>
@@ -673,6 +680,12 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
             throw SceneError("/surface: give either `shape` or `mesh_file`");
         if (scene.shape && !scene.surface.mesh_file.empty())
             throw SceneError("/surface: give either `shape` or `mesh_file`, not both");
+        if (!scene.time.land_on_frames && scene.flow.type == "fluid")
+            throw SceneError("/time/land_on_frames: fluid scenes always land on frame times");
+        if (scene.surface.open && scene.shape)
+            throw SceneError("/surface/open: only a mesh_file can be open (shapes are closed)");
+        if (scene.surface.open && scene.flow.type == "fluid")
+            throw SceneError("/surface/open: fluid scenes need a closed surface");
         if (!scene.surface.mesh_file.empty() && scene.surface.mesh_file.front() != '/' &&
             !base_dir.empty())
             scene.surface.mesh_file = base_dir + "/" + scene.surface.mesh_file;

@@ -25,6 +25,9 @@ struct SurfaceOptions {
     /// Which phase the shape encloses: "liquid" (drops, pools: region labels {1, 0}) or "gas"
     /// (bubbles in a liquid that fills the rest: labels {0, 1}).
     std::string inside = "liquid";
+    /// The mesh_file is an open surface (paper §4.4): boundary edges are allowed (and never
+    /// split, flipped, collapsed or merged). Geometric flows only; implicit shapes are closed.
+    bool open = false;
 };
 
 /// Motion in the normal direction (paper §4.1, VALIDATION.md A1).
@@ -95,6 +98,10 @@ struct TimeOptions {
     double end = 3.0;  ///< simulated end time (s)
     int frames = 30;   ///< frames written after the initial one, evenly spaced in time
     double dt = 0.01;  ///< maximum time step (s); steps are shortened to land on frame times
+    /// Geometric flows: false lets steps run past frame times (a frame is then written after
+    /// the first step that reaches its time, at that step's time), so the sequence of steps
+    /// is the one `meniscus validate` takes; the end time is still hit exactly.
+    bool land_on_frames = true;
 };
 
 /// What is written every frame.

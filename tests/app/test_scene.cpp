@@ -146,6 +146,17 @@ TEST(Scene, GeometricFlowErrorsNameTheJsonPath) {
               std::string::npos);
 }
 
+TEST(Scene, OnlyMeshFilesOfGeometricFlowsMayBeOpen) {
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}, "open": true}})")
+                  .find("/surface/open: only a mesh_file can be open"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"mesh_file": "m.obj", "open": true}, "flow": {"type": "fluid"}})")
+                  .find("/surface/open: fluid scenes need a closed surface"),
+              std::string::npos);
+    EXPECT_TRUE(parse_scene(R"({"surface": {"mesh_file": "m.obj", "open": true}})", "t.json", ".")
+                    .surface.open);
+}
+
 TEST(Scene, WavyHalfSpaceSlab) {
     const Scene s = parse_scene(R"({"surface": {"shape": {"type": "intersection", "shapes": [
         {"type": "wavy_half_space", "origin": [0.25, 0, 0.5], "amplitude": 0.05,

@@ -5,6 +5,7 @@
 #include "tracker/flows/flow_errors.h"
 #include "tracker/mesh_io.h"
 #include "tracker/mesh_measures.h"
+#include "tracker/mesh_validate.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -142,21 +143,64 @@ TEST(FlowScenes, SphereUnderMeanCurvatureRecordsTheExactRadius) {
     scene.tracker.verify_intersection_free = false;
     RunOptions options;
     options.out_dir = (fs::temp_directory_path() / "meniscus_a2_exact").string();
-    options.frames = 1;  // t = 0.00125
+    const fs::path last_frame = fs::path(options.out_dir) / "surface_0002.ply";
+    ASSERT_FALSE(scene.time.land_on_frames);  // steps as in `meniscus validate`
+    options.frames = 2;                        // frame times 0.00125 and 0.0025
     options.quiet = true;
     const std::atomic<bool> stop{false};
     run_scene(scene, options, stop);
-    const auto lines = read_stats(options.out_dir);
-    ASSERT_EQ(lines.size(), 2u);
+    auto lines = read_stats(options.out_dir);
+    ASSERT_EQ(lines.size(), 3u);
+    // Frame 1 is written after the first step reaching its time; the last lands on the end.
+    const double frame_dt = scene.time.end / scene.time.frames;
+    EXPECT_GE(lines[1]["time"].get<double>(), frame_dt);
+    EXPECT_LT(lines[1]["time"].get<double>(), frame_dt + lines[1]["dt"].get<double>());
+    EXPECT_EQ(lines[2]["time"].get<double>(), 2 * frame_dt);
+    lines.erase(lines.begin() + 1);
     const double t = lines[1]["time"];
     const double exact_radius = std::sqrt(0.3 * 0.3 - 4.0 * t);
     EXPECT_DOUBLE_EQ(lines[1]["exact_error"]["radius"].get<double>(), exact_radius);
-    // The sphere shrank by 0.0085 m; the discrete flow follows it to a small fraction of that.
+    // The sphere shrank by 0.017 m; the discrete flow follows it to a small fraction of that.
     EXPECT_LT(lines[1]["exact_error"]["vertex_linf"].get<double>(), 0.1 * (0.3 - exact_radius));
     const tracker::SurfaceMesh mesh = tracker::to_surface_mesh(
-        tracker::read_mesh_file((fs::path(options.out_dir) / "surface_0001.ply").string()), "ply");
+        tracker::read_mesh_file(last_frame.string()), "ply");
     EXPECT_NEAR(lines[1]["exact_error"]["l1"].get<double>(),
                 tracker::sphere_error(mesh, Eigen::Vector3d::Zero(), exact_radius).l1, 1e-12);
+    fs::remove_all(options.out_dir);
+}
+
+TEST(FlowScenes, OpenSheetKeepsItsBoundaryUnderCurlNoise) {
+    Scene scene = load_scene(FLOW_SCENES + "a4_curl_noise_open_xi0.04.json");
+    RunOptions options;
+    options.out_dir = (fs::temp_directory_path() / "meniscus_open_sheet").string();
+    options.frames = 1;  // t = 0.5: 10 RK4 steps
+    options.quiet = true;
+    const std::atomic<bool> stop{false};
+    const RunResult r = run_scene(scene, options, stop);
+    EXPECT_EQ(r.max_intersecting_pairs, 0);
+    const auto count_boundary = [](const tracker::SurfaceMesh& m) {
+        int n = 0;
+        for (int ei = 0; ei < m.num_edges(); ++ei)
+            n += !m.edge_triangles(ei).empty() && m.is_boundary_edge(ei) ? 1 : 0;
+        return n;
+    };
+    const auto load = [&](const char* name) {
+        return tracker::to_surface_mesh(
+            tracker::read_mesh_file((fs::path(options.out_dir) / name).string()), name);
+    };
+    const tracker::SurfaceMesh before = load("surface_0000.ply"), after = load("surface_0001.ply");
+    tracker::ValidationOptions open;
+    open.allow_boundary = true;
+    EXPECT_TRUE(tracker::validate_mesh(after, open).empty());
+    // Boundary edges are never split, flipped or collapsed: the same boundary, moved.
+    EXPECT_GT(count_boundary(before), 0);
+    EXPECT_EQ(count_boundary(after), count_boundary(before));
+    // The sheet starts in the plane y = 0; the planar field moves it in x and y.
+    double moved = 0.0;
+    for (int vi = 0; vi < after.num_vertices(); ++vi)
+        if (after.vertex_alive(vi) && after.is_boundary_vertex(vi))
+            moved = std::max(moved, std::abs(after.position(vi).y()));
+    EXPECT_GT(moved, 1e-3);
     fs::remove_all(options.out_dir);
 }
 
