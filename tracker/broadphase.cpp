@@ -94,12 +94,78 @@ SpatialHash::SpatialHash(double cell_size) : m_cell(cell_size) {
         throw std::invalid_argument("SpatialHash: cell_size must be a finite number > 0");
 }
 
-std::uint64_t SpatialHash::key(int i, int j, int k) {
-    // Large-prime mixing; distinct cells may share a key, which only merges candidate lists
-    // (the exact box filter removes the extras).
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) * 73856093ULL) ^
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(j)) * 19349663ULL << 21) ^
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k)) * 83492791ULL << 42);
+namespace {
+
+/// SpatialHash table: initial slot count (a power of two) and maximum load before growing.
+constexpr size_t SPATIAL_HASH_INITIAL_SLOTS = 1024;
+constexpr double SPATIAL_HASH_MAX_LOAD = 0.5;
+/// Cell coordinates are packed 21 bits per axis; beyond ±2²⁰ cells they alias, which only merges
+/// lists (the exact box filter removes the extras).
+constexpr std::int64_t CELL_BITS_MASK = (1 << 21) - 1;
+constexpr std::int64_t CELL_OFFSET = 1 << 20;
+
+std::uint64_t mix_key(std::int64_t key) {
+    std::uint64_t x = static_cast<std::uint64_t>(key);
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    return x;
+}
+
+}  // namespace
+
+std::int64_t SpatialHash::key(int i, int j, int k) {
+    return ((static_cast<std::int64_t>(i) + CELL_OFFSET) & CELL_BITS_MASK) |
+           (((static_cast<std::int64_t>(j) + CELL_OFFSET) & CELL_BITS_MASK) << 21) |
+           (((static_cast<std::int64_t>(k) + CELL_OFFSET) & CELL_BITS_MASK) << 42);
+}
+
+int SpatialHash::find_slot(std::int64_t key) const {
+    if (m_slot_key.empty())
+        return -1;
+    const size_t mask = m_slot_key.size() - 1;
+    size_t slot = mix_key(key) & mask;
+    while (m_slot_key[slot] != -1) {
+        if (m_slot_key[slot] == key)
+            return static_cast<int>(slot);
+        slot = (slot + 1) & mask;
+    }
+    return -1;
+}
+
+void SpatialHash::grow() {
+    const size_t slots = m_slot_key.empty() ? SPATIAL_HASH_INITIAL_SLOTS : 2 * m_slot_key.size();
+    std::vector<std::int64_t> old_key(slots, -1);
+    std::vector<int> old_head(slots, -1);
+    old_key.swap(m_slot_key);
+    old_head.swap(m_slot_head);
+    const size_t mask = slots - 1;
+    for (size_t i = 0; i < old_key.size(); ++i) {
+        if (old_key[i] == -1)
+            continue;
+        size_t slot = mix_key(old_key[i]) & mask;
+        while (m_slot_key[slot] != -1)
+            slot = (slot + 1) & mask;
+        m_slot_key[slot] = old_key[i];
+        m_slot_head[slot] = old_head[i];
+    }
+}
+
+int SpatialHash::find_or_add_slot(std::int64_t key) {
+    if (static_cast<double>(m_used_slots + 1) >
+        SPATIAL_HASH_MAX_LOAD * static_cast<double>(m_slot_key.size()))
+        grow();
+    const size_t mask = m_slot_key.size() - 1;
+    size_t slot = mix_key(key) & mask;
+    while (m_slot_key[slot] != -1) {
+        if (m_slot_key[slot] == key)
+            return static_cast<int>(slot);
+        slot = (slot + 1) & mask;
+    }
+    m_slot_key[slot] = key;
+    m_slot_head[slot] = -1;
+    ++m_used_slots;
+    return static_cast<int>(slot);
 }
 
 SpatialHash::CellRange SpatialHash::cells_of(const Box3d& box) const {
@@ -139,8 +205,20 @@ void SpatialHash::insert(int id, const Box3d& box) {
     }
     for (int z = r.lo.z(); z <= r.hi.z(); ++z)
         for (int y = r.lo.y(); y <= r.hi.y(); ++y)
-            for (int x = r.lo.x(); x <= r.hi.x(); ++x)
-                m_grid[key(x, y, z)].push_back(id);
+            for (int x = r.lo.x(); x <= r.hi.x(); ++x) {
+                const auto slot = static_cast<size_t>(find_or_add_slot(key(x, y, z)));
+                int entry = m_free_entry;
+                if (entry >= 0) {
+                    m_free_entry = m_entry_next[static_cast<size_t>(entry)];
+                } else {
+                    entry = static_cast<int>(m_entry_id.size());
+                    m_entry_id.push_back(id);
+                    m_entry_next.push_back(-1);
+                }
+                m_entry_id[static_cast<size_t>(entry)] = id;
+                m_entry_next[static_cast<size_t>(entry)] = m_slot_head[slot];
+                m_slot_head[slot] = entry;
+            }
 }
 
 void SpatialHash::remove(int id) {
@@ -148,25 +226,29 @@ void SpatialHash::remove(int id) {
         return;
     const auto i = static_cast<size_t>(id);
     const CellRange& r = m_ranges[i];
-    const auto erase = [id](std::vector<int>& list) {
-        auto it = std::find(list.begin(), list.end(), id);
-        if (it != list.end()) {
-            *it = list.back();
-            list.pop_back();
-        }
-    };
     if (r.oversized) {
-        erase(m_oversized);
+        auto it = std::find(m_oversized.begin(), m_oversized.end(), id);
+        if (it != m_oversized.end()) {
+            *it = m_oversized.back();
+            m_oversized.pop_back();
+        }
     } else {
         for (int z = r.lo.z(); z <= r.hi.z(); ++z)
             for (int y = r.lo.y(); y <= r.hi.y(); ++y)
                 for (int x = r.lo.x(); x <= r.hi.x(); ++x) {
-                    auto it = m_grid.find(key(x, y, z));
-                    if (it == m_grid.end())
+                    const int slot = find_slot(key(x, y, z));
+                    if (slot < 0)
                         continue;
-                    erase(it->second);
-                    if (it->second.empty())
-                        m_grid.erase(it);
+                    // Unlink one entry of `id` from the cell's list.
+                    int* link = &m_slot_head[static_cast<size_t>(slot)];
+                    while (*link >= 0 && m_entry_id[static_cast<size_t>(*link)] != id)
+                        link = &m_entry_next[static_cast<size_t>(*link)];
+                    if (*link < 0)
+                        continue;
+                    const int entry = *link;
+                    *link = m_entry_next[static_cast<size_t>(entry)];
+                    m_entry_next[static_cast<size_t>(entry)] = m_free_entry;
+                    m_free_entry = entry;
                 }
     }
     m_present[i] = 0;
@@ -189,12 +271,15 @@ void SpatialHash::query(const Box3d& box, std::vector<int>& out) const {
     for (int z = r.lo.z(); z <= r.hi.z(); ++z)
         for (int y = r.lo.y(); y <= r.hi.y(); ++y)
             for (int x = r.lo.x(); x <= r.hi.x(); ++x) {
-                auto it = m_grid.find(key(x, y, z));
-                if (it == m_grid.end())
+                const int slot = find_slot(key(x, y, z));
+                if (slot < 0)
                     continue;
-                for (int id : it->second)
+                for (int entry = m_slot_head[static_cast<size_t>(slot)]; entry >= 0;
+                     entry = m_entry_next[static_cast<size_t>(entry)]) {
+                    const int id = m_entry_id[static_cast<size_t>(entry)];
                     if (overlaps(m_boxes[static_cast<size_t>(id)], box))
                         out.push_back(id);
+                }
             }
     for (int id : m_oversized)
         if (overlaps(m_boxes[static_cast<size_t>(id)], box))
@@ -204,7 +289,12 @@ void SpatialHash::query(const Box3d& box, std::vector<int>& out) const {
 }
 
 void SpatialHash::clear() {
-    m_grid.clear();
+    m_slot_key.clear();
+    m_slot_head.clear();
+    m_used_slots = 0;
+    m_entry_id.clear();
+    m_entry_next.clear();
+    m_free_entry = -1;
     m_oversized.clear();
     m_boxes.clear();
     m_ranges.clear();
@@ -228,11 +318,14 @@ constexpr int HALF_STENCIL[13][3] = {{0, 0, 1},  {0, 1, -1},  {0, 1, 0},  {0, 1,
                                      {1, -1, 0}, {1, -1, 1},  {1, 0, -1}, {1, 0, 0},  {1, 0, 1},
                                      {1, 1, -1}, {1, 1, 0},   {1, 1, 1}};
 
-/// Closed-box overlap on raw coordinates (the hot loop of the pair enumeration).
+/// Closed-box overlap on raw coordinates (the hot loop of the pair enumeration). Evaluates all
+/// six comparisons without short-circuiting: most candidates fail on a random axis, and one
+/// well-predicted branch on the combined result is cheaper than up to six unpredictable ones.
 inline bool boxes_overlap(const Box3d& a, const Box3d& b) {
-    return a.min().x() <= b.max().x() && b.min().x() <= a.max().x() &&
-           a.min().y() <= b.max().y() && b.min().y() <= a.max().y() &&
-           a.min().z() <= b.max().z() && b.min().z() <= a.max().z();
+    const bool x = (a.min().x() <= b.max().x()) & (b.min().x() <= a.max().x());
+    const bool y = (a.min().y() <= b.max().y()) & (b.min().y() <= a.max().y());
+    const bool z = (a.min().z() <= b.max().z()) & (b.min().z() <= a.max().z());
+    return x & y & z;
 }
 
 std::uint64_t mix(std::int64_t key) {
@@ -289,10 +382,12 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
     m_slot_key.assign(slots, -1);
     m_slot_range.assign(slots, {0, 0});
     m_ids.resize(keyed.size());
+    m_cell_boxes.resize(keyed.size());
     for (size_t i = 0; i < keyed.size();) {
         size_t j = i;
         while (j < keyed.size() && keyed[j].first == keyed[i].first) {
             m_ids[j] = keyed[j].second;
+            m_cell_boxes[j] = boxes[static_cast<size_t>(keyed[j].second)];
             ++j;
         }
         size_t slot = mix(keyed[i].first) & (slots - 1);
@@ -320,25 +415,19 @@ void LooseGrid::visit(size_t task, F&& f) const {
     if (task < m_cells.size()) {
         const Cell& cell = m_cells[task];
         for (int a = cell.begin; a < cell.end; ++a) {
-            const int ia = m_ids[static_cast<size_t>(a)];
-            const Box3d& box_a = m_boxes[static_cast<size_t>(ia)];
-            for (int b = a + 1; b < cell.end; ++b) {
-                const int ib = m_ids[static_cast<size_t>(b)];
-                if (boxes_overlap(box_a, m_boxes[static_cast<size_t>(ib)]))
-                    f(ia, ib);
-            }
+            const Box3d& box_a = m_cell_boxes[static_cast<size_t>(a)];
+            for (int b = a + 1; b < cell.end; ++b)
+                if (boxes_overlap(box_a, m_cell_boxes[static_cast<size_t>(b)]))
+                    f(m_ids[static_cast<size_t>(a)], m_ids[static_cast<size_t>(b)]);
         }
         for (const auto& offset : HALF_STENCIL) {
             const auto [begin, end] = find_cell(
                 cell_key(cell.coords + Eigen::Array3i(offset[0], offset[1], offset[2])));
             for (int b = begin; b < end; ++b) {
-                const int ib = m_ids[static_cast<size_t>(b)];
-                const Box3d& box_b = m_boxes[static_cast<size_t>(ib)];
-                for (int a = cell.begin; a < cell.end; ++a) {
-                    const int ia = m_ids[static_cast<size_t>(a)];
-                    if (boxes_overlap(m_boxes[static_cast<size_t>(ia)], box_b))
-                        f(ia, ib);
-                }
+                const Box3d& box_b = m_cell_boxes[static_cast<size_t>(b)];
+                for (int a = cell.begin; a < cell.end; ++a)
+                    if (boxes_overlap(m_cell_boxes[static_cast<size_t>(a)], box_b))
+                        f(m_ids[static_cast<size_t>(a)], m_ids[static_cast<size_t>(b)]);
             }
         }
         return;
@@ -381,11 +470,9 @@ void LooseGrid::query(const Box3d& box, std::vector<int>& out) const {
                 if (m_slot_key[slot] == -1)
                     continue;
                 const auto [begin, end] = m_slot_range[slot];
-                for (int k = begin; k < end; ++k) {
-                    const int id = m_ids[static_cast<size_t>(k)];
-                    if (overlaps(m_boxes[static_cast<size_t>(id)], box))
-                        out.push_back(id);
-                }
+                for (int k = begin; k < end; ++k)
+                    if (boxes_overlap(m_cell_boxes[static_cast<size_t>(k)], box))
+                        out.push_back(m_ids[static_cast<size_t>(k)]);
             }
     for (int id : m_oversized)
         if (overlaps(m_boxes[static_cast<size_t>(id)], box))

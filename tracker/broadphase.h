@@ -16,14 +16,14 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 namespace meniscus::tracker {
 
 using Box3d = Eigen::AlignedBox3d;
 
-/// Dynamic uniform-grid hash of boxes keyed by element index.
+/// Dynamic uniform-grid hash of boxes keyed by element index. Flat storage: an open-addressing
+/// table of cells whose lists are linked entries in one pool.
 class SpatialHash {
 public:
     /// `cell_size` (> 0, metres) should be near the typical box extent. Throws otherwise.
@@ -46,10 +46,23 @@ private:
         bool oversized = false;
     };
     CellRange cells_of(const Box3d& box) const;
-    static std::uint64_t key(int i, int j, int k);
+    static std::int64_t key(int i, int j, int k);
+    /// Slot of `key` in the open-addressing table, or −1 when absent.
+    int find_slot(std::int64_t key) const;
+    /// Slot of `key`, added (with an empty list) when absent; may grow the table.
+    int find_or_add_slot(std::int64_t key);
+    void grow();
 
     double m_cell;
-    std::unordered_map<std::uint64_t, std::vector<int>> m_grid;
+    // Flat hash of cells (open addressing, linear probing; keys stay once added, with possibly
+    // empty lists, until clear()): per slot the cell key (−1 = free) and the head of its list.
+    std::vector<std::int64_t> m_slot_key;
+    std::vector<int> m_slot_head;
+    size_t m_used_slots = 0;
+    // Cell lists as singly linked entries in one pool, with a free list (no allocation per
+    // cell or per insert once the pool has grown).
+    std::vector<int> m_entry_id, m_entry_next;
+    int m_free_entry = -1;
     std::vector<int> m_oversized;  // boxes spanning too many cells, checked on every query
     std::vector<Box3d> m_boxes;
     std::vector<CellRange> m_ranges;
@@ -123,6 +136,7 @@ private:
     const std::vector<Box3d>& m_boxes;
     double m_cell = 1.0;
     std::vector<int> m_ids;                         // ids grouped by cell
+    std::vector<Box3d> m_cell_boxes;                // their boxes, same order (sequential reads)
     std::vector<std::int64_t> m_slot_key;           // flat hash: key per slot (−1 = empty)
     std::vector<std::pair<int, int>> m_slot_range;  // [begin, end) into m_ids per slot
     std::vector<Cell> m_cells;                      // occupied cells in key order

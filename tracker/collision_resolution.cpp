@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -28,6 +29,17 @@ constexpr double IMPULSE_SEPARATION_FRACTION = 0.1;
 /// Relative Tikhonov regularization of the impact-zone system (redundant constraints make
 /// C M⁻¹ Cᵀ singular).
 constexpr double ZONE_REGULARIZATION = 1e-12;
+/// Extra padding of the shared broad phase, in units of ε_p: the candidate pairs found once for
+/// the repulsion (static boxes at t0, padded ε_p/2) and the first CCD sweep (swept boxes) stay a
+/// superset for any later displacement within half of this of the one they were built for, so
+/// repulsion impulses and small CCD impulses do not force a new broad phase. (ε_p is ~10⁻³ ξ,
+/// so the extra candidates are a few per cent.)
+constexpr double CANDIDATE_SLACK_FRACTION = 8.0;
+/// The reuse test leaves this fraction of the slack unused, for the rounding of box corners.
+constexpr double CANDIDATE_SLACK_SAFETY = 0.5;
+/// Box corners are rounded sums of coordinates; the slack must dwarf their rounding error
+/// (this many units in the last place of the largest coordinate) or the candidates are rebuilt.
+constexpr double CANDIDATE_ROUNDING_ULPS = 64.0;
 
 /// One possible contact between four vertices with weights ā (Σ āᵢ xᵢ = separation vector) and
 /// a unit normal n: the constraint row is āᵢ nᵀ per vertex.
@@ -89,18 +101,34 @@ bool apply_impulse(const Contact& c, const std::vector<double>& inv_mass, std::v
     return true;
 }
 
+/// Candidate pairs of a broad phase over the motion x_t0 → x_t0 + d_ref with boxes padded by
+/// `padding`: a superset of the pairs whose boxes overlap for any motion x_t0 → x_t0 + d with
+/// ‖d − d_ref‖∞ small enough (see covers()).
+struct Candidates {
+    std::vector<VertexTrianglePair> vertex_triangle;
+    std::vector<EdgeEdgePair> edge_edge;
+    std::vector<Vec3> d_ref;
+    double padding = 0.0;
+};
+
 class Resolver {
 public:
     Resolver(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0, const CollisionOptions& o,
              std::vector<double> inv_mass)
         : m_mesh(mesh), m_x0(x_t0), m_o(o), m_inv_mass(std::move(inv_mass)) {}
 
-    /// Phase 1: proximity repulsion at t0 (paper: push apart to ε_p over the step).
-    int repel(std::vector<Vec3>& d) const {
-        const BroadPhase broad(m_mesh, m_x0, m_x0, 0.5 * m_o.proximity_epsilon);
+    /// Phase 1: proximity repulsion at t0 (paper: push apart to ε_p over the step). Builds the
+    /// broad phase that the first CCD sweep reuses: swept boxes of the requested motion padded
+    /// by ε_p/2 plus a slack contain the static boxes repulsion needs; candidates are filtered
+    /// by the exact static box test, so the contacts are the ones a static broad phase gives.
+    int repel(std::vector<Vec3>& d) {
+        const double padding = 0.5 * m_o.proximity_epsilon;
+        m_candidates = build_candidates(d, padding + CANDIDATE_SLACK_FRACTION * m_o.proximity_epsilon);
         std::vector<Contact> contacts;
-        for (const VertexTrianglePair& p : broad.vertex_triangle_pairs()) {
+        for (const VertexTrianglePair& p : m_candidates.vertex_triangle) {
             const Triangle& t = m_mesh.triangle(p.ti);
+            if (!boxes_overlap(static_box({p.vi}, padding), static_box({t[0], t[1], t[2]}, padding)))
+                continue;
             const auto prox = point_triangle_proximity(x0(p.vi), x0(t[0]), x0(t[1]), x0(t[2]));
             if (prox.distance < m_o.proximity_epsilon)
                 contacts.push_back({{p.vi, t[0], t[1], t[2]},
@@ -108,9 +136,11 @@ public:
                                     prox.normal,
                                     m_o.proximity_epsilon - prox.distance});
         }
-        for (const EdgeEdgePair& p : broad.edge_edge_pairs()) {
+        for (const EdgeEdgePair& p : m_candidates.edge_edge) {
             const Edge& a = m_mesh.edge(p.ei);
             const Edge& b = m_mesh.edge(p.ej);
+            if (!boxes_overlap(static_box({a[0], a[1]}, padding), static_box({b[0], b[1]}, padding)))
+                continue;
             const auto prox = edge_edge_proximity(x0(a[0]), x0(a[1]), x0(b[0]), x0(b[1]));
             if (prox.distance < m_o.proximity_epsilon)
                 contacts.push_back({{a[0], a[1], b[0], b[1]},
@@ -123,14 +153,17 @@ public:
         return static_cast<int>(contacts.size());
     }
 
-    /// Every possible collision of the motion x0 → x0 + d (exact broad phase + CCD).
-    std::vector<Contact> detect(const std::vector<Vec3>& d) const {
+    /// Every possible collision of the motion x0 → x0 + d (exact broad phase + CCD). Reuses the
+    /// last candidates when they still cover d, else builds new ones (with slack, for the next
+    /// call); either way only pairs whose swept boxes overlap exactly are tested.
+    std::vector<Contact> detect(const std::vector<Vec3>& d) {
         std::vector<Vec3> x1(m_x0.size());
         for (size_t i = 0; i < x1.size(); ++i)
             x1[i] = m_x0[i] + d[i];
-        const BroadPhase broad(m_mesh, m_x0, x1, 0.0);
-        const auto vt = broad.vertex_triangle_pairs();
-        const auto ee = broad.edge_edge_pairs();
+        if (!covers(m_candidates, d))
+            m_candidates = build_candidates(d, CANDIDATE_SLACK_FRACTION * m_o.proximity_epsilon);
+        const std::vector<VertexTrianglePair> vt = filter_vertex_triangle(x1);
+        const std::vector<EdgeEdgePair> ee = filter_edge_edge(x1);
         tbb::enumerable_thread_specific<std::vector<Contact>> local;
         const double target = IMPULSE_SEPARATION_FRACTION * m_o.proximity_epsilon;
         tbb::parallel_for(tbb::blocked_range<size_t>(0, vt.size() + ee.size(), PARALLEL_GRAIN),
@@ -162,7 +195,7 @@ public:
 
     /// Phase 3: impact zones (Harmon et al. 2008 inelastic projection, paper §3.8).
     /// Returns true when the motion is collision-free at the end.
-    bool impact_zones(std::vector<Vec3>& d, CollisionReport& report) const {
+    bool impact_zones(std::vector<Vec3>& d, CollisionReport& report) {
         std::vector<Contact> constraints;
         for (int it = 0; it < m_o.max_impact_zone_iterations; ++it) {
             std::vector<Contact> fresh = detect(d);
@@ -179,7 +212,7 @@ public:
     /// linear and angular momentum of its vertices; zones merge as new collisions appear.
     /// The linear interpolation of a rigid velocity field is an affine map with determinant
     /// 1 + t²|ω|² > 0, so a zone never collides with itself.
-    bool rigid_zones(std::vector<Vec3>& d, CollisionReport& report) const {
+    bool rigid_zones(std::vector<Vec3>& d, CollisionReport& report) {
         std::vector<int> parent(m_x0.size());
         std::iota(parent.begin(), parent.end(), 0);
         std::vector<std::uint8_t> in_zone(m_x0.size(), 0);
@@ -200,6 +233,79 @@ public:
 
 private:
     const Vec3& x0(int vi) const { return m_x0[static_cast<size_t>(vi)]; }
+
+    Candidates build_candidates(const std::vector<Vec3>& d, double padding) const {
+        std::vector<Vec3> x1(m_x0.size());
+        for (size_t i = 0; i < x1.size(); ++i)
+            x1[i] = m_x0[i] + d[i];
+        const BroadPhase broad(m_mesh, m_x0, x1, padding);
+        return {broad.vertex_triangle_pairs(), broad.edge_edge_pairs(), d, padding};
+    }
+
+    /// True when every box of the motion x0 → x0 + d (unpadded) lies inside the corresponding
+    /// box the candidates were built from: each end position moved by at most half the padding
+    /// (the other half absorbs the rounding of the corners, which must be negligible).
+    bool covers(const Candidates& c, const std::vector<Vec3>& d) const {
+        if (c.d_ref.size() != d.size() || !(c.padding > 0.0))
+            return false;
+        double moved = 0.0, coordinate = 0.0;
+        for (size_t i = 0; i < d.size(); ++i) {
+            moved = std::max(moved, (d[i] - c.d_ref[i]).cwiseAbs().maxCoeff());
+            coordinate = std::max({coordinate, m_x0[i].cwiseAbs().maxCoeff(),
+                                   (m_x0[i] + d[i]).cwiseAbs().maxCoeff(),
+                                   (m_x0[i] + c.d_ref[i]).cwiseAbs().maxCoeff()});
+        }
+        const double rounding =
+            CANDIDATE_ROUNDING_ULPS * std::numeric_limits<double>::epsilon() * coordinate;
+        return std::isfinite(moved) && std::isfinite(coordinate) &&
+               CANDIDATE_SLACK_SAFETY * c.padding > rounding &&
+               moved <= CANDIDATE_SLACK_SAFETY * c.padding - rounding;
+    }
+
+    Box3d static_box(std::initializer_list<int> vertices, double padding) const {
+        Box3d b;
+        for (int vi : vertices)
+            b.extend(x0(vi));
+        b.min().array() -= padding;
+        b.max().array() += padding;
+        return b;
+    }
+
+    Box3d moving_box(std::initializer_list<int> vertices, const std::vector<Vec3>& x1) const {
+        Box3d b;
+        for (int vi : vertices) {
+            b.extend(x0(vi));
+            b.extend(x1[static_cast<size_t>(vi)]);
+        }
+        return b;
+    }
+
+    static bool boxes_overlap(const Box3d& a, const Box3d& b) {
+        return (a.min().array() <= b.max().array()).all() &&
+               (b.min().array() <= a.max().array()).all();
+    }
+
+    /// The candidates whose unpadded swept boxes overlap: exactly what BroadPhase(x0, x1, 0)
+    /// returns, in the same (sorted) order.
+    std::vector<VertexTrianglePair> filter_vertex_triangle(const std::vector<Vec3>& x1) const {
+        std::vector<VertexTrianglePair> out;
+        for (const VertexTrianglePair& p : m_candidates.vertex_triangle) {
+            const Triangle& t = m_mesh.triangle(p.ti);
+            if (boxes_overlap(moving_box({p.vi}, x1), moving_box({t[0], t[1], t[2]}, x1)))
+                out.push_back(p);
+        }
+        return out;
+    }
+    std::vector<EdgeEdgePair> filter_edge_edge(const std::vector<Vec3>& x1) const {
+        std::vector<EdgeEdgePair> out;
+        for (const EdgeEdgePair& p : m_candidates.edge_edge) {
+            const Edge& a = m_mesh.edge(p.ei);
+            const Edge& b = m_mesh.edge(p.ej);
+            if (boxes_overlap(moving_box({a[0], a[1]}, x1), moving_box({b[0], b[1]}, x1)))
+                out.push_back(p);
+        }
+        return out;
+    }
 
     void test(const std::array<int, 4>& v, const std::vector<Vec3>& x1, bool edge_edge,
               double target, std::vector<Contact>& out) const {
@@ -376,6 +482,7 @@ private:
     const std::vector<Vec3>& m_x0;
     const CollisionOptions& m_o;
     std::vector<double> m_inv_mass;
+    Candidates m_candidates;
 };
 
 }  // namespace
@@ -407,7 +514,7 @@ CollisionReport resolve_collisions(const SurfaceMesh& mesh, const std::vector<Ve
     if (!(dt > 0.0) || !std::isfinite(dt))
         throw std::invalid_argument("resolve_collisions: dt must be a finite number > 0");
     const std::vector<double> inv = inverse_masses(mesh, masses, pinned);
-    const Resolver resolver(mesh, x_t0, options, inv);
+    Resolver resolver(mesh, x_t0, options, inv);
 
     // Work with displacements d = x_t1 − x_t0 (velocities times dt).
     std::vector<Vec3> d(n);
@@ -460,7 +567,7 @@ CollisionReport resolve_collisions(const SurfaceMesh& mesh, const std::vector<Ve
 bool motion_is_collision_free(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
                               const std::vector<Vec3>& x_t1) {
     CollisionOptions o;
-    const Resolver resolver(mesh, x_t0, o, std::vector<double>(x_t0.size(), 1.0));
+    Resolver resolver(mesh, x_t0, o, std::vector<double>(x_t0.size(), 1.0));
     std::vector<Vec3> d(x_t0.size());
     if (x_t1.size() != x_t0.size())
         throw std::invalid_argument("motion_is_collision_free: position counts differ");

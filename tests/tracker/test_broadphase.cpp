@@ -79,6 +79,70 @@ TEST(SpatialHash, InsertRemoveUpdateQuery) {
     EXPECT_EQ(out, (std::vector<int>{7, 9}));
 }
 
+// Random inserts, moves and removals (boxes from tiny to many cells wide, some far from the
+// origin) against a brute-force list: every query must equal the brute-force answer.
+TEST(SpatialHash, RandomUpdatesMatchBruteForce) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> pos(-3.0, 3.0), size(0.0, 0.4), coin(0.0, 1.0);
+    SpatialHash h(0.25);
+    std::vector<Box3d> boxes(300);  // empty = absent
+    const auto random_box = [&]() {
+        const Vec3 lo(pos(rng), pos(rng), pos(rng));
+        const double scale = coin(rng) < 0.05 ? 20.0 : 1.0;  // a few oversized
+        const Vec3 hi = lo + scale * Vec3(size(rng), size(rng), size(rng));
+        return Box3d(lo, hi);
+    };
+    std::vector<int> out;
+    for (int round = 0; round < 4000; ++round) {
+        const int id = static_cast<int>(rng() % boxes.size());
+        if (coin(rng) < 0.3) {
+            h.remove(id);
+            boxes[static_cast<size_t>(id)].setEmpty();
+        } else {
+            boxes[static_cast<size_t>(id)] = random_box();
+            h.insert(id, boxes[static_cast<size_t>(id)]);
+        }
+        if (round % 20 != 0)
+            continue;
+        const Box3d q = random_box();
+        h.query(q, out);
+        std::vector<int> expected;
+        for (size_t i = 0; i < boxes.size(); ++i)
+            if (!boxes[i].isEmpty() && boxes[i].intersects(q))
+                expected.push_back(static_cast<int>(i));
+        ASSERT_EQ(out, expected) << "round " << round;
+        for (size_t i = 0; i < boxes.size(); ++i)
+            ASSERT_EQ(h.contains(static_cast<int>(i)), !boxes[i].isEmpty());
+    }
+}
+
+// Triangle pairs of the static broad phase equal brute force (self join over one grid).
+TEST(BroadPhaseTrianglePairs, EqualBruteForce) {
+    const SurfaceMesh m = meshed(
+        make_union({make_sphere({0, 0, 0}, 0.2), make_torus({0.25, 0, 0}, {1, 1, 0}, 0.2, 0.06)}),
+        0.04);
+    for (double padding : {0.0, 0.01, 0.3}) {
+        const BroadPhase broad(m, padding);
+        std::vector<TrianglePair> expected;
+        for (int ti = 0; ti < m.num_triangles(); ++ti)
+            for (int tj = ti + 1; tj < m.num_triangles(); ++tj) {
+                if (!m.triangle_alive(ti) || !m.triangle_alive(tj))
+                    continue;
+                const auto box = [&](int t) {
+                    Box3d b;
+                    for (int vi : m.triangle(t))
+                        b.extend(m.position(vi));
+                    b.min().array() -= padding;
+                    b.max().array() += padding;
+                    return b;
+                };
+                if (box(ti).intersects(box(tj)))
+                    expected.push_back({ti, tj});
+            }
+        EXPECT_EQ(broad.triangle_pairs(), expected) << "padding " << padding;
+    }
+}
+
 TEST(MeshIntersections, GeneratedMeshesAreIntersectionFree) {
     for (const auto& shape :
          {make_sphere({0, 0, 0}, 0.3), make_torus({0, 0, 0}, {0, 0, 1}, 0.3, 0.05),
