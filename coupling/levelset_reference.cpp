@@ -14,6 +14,8 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace meniscus::coupling {
 
@@ -34,6 +36,8 @@ constexpr int NEWTON_STEPS = 3;
 constexpr double PROJECTION_TOLERANCE_FRACTION = 1e-7;
 /// Below this central-difference |∇φ| the curvature step uses the Laplacian (see the step).
 constexpr float DEGENERATE_GRADIENT = 0.5f;
+/// Largest motion of a voxel value in one curvature step, in voxels (see the step).
+constexpr double MAX_STEP_VOXELS = 0.5;
 /// Largest index extent of the scanned box (voxels per axis).
 constexpr double MAX_VOXELS_PER_AXIS = 2147483000.0;
 
@@ -110,32 +114,55 @@ openvdb::FloatGrid::Ptr initial_band(const tracker::ImplicitShape& shape, double
 /// band voxel EXCEPT the interface voxels (those with a face neighbour of the other sign), which
 /// keep their values so the zero crossings stay where the curvature step put them, then trims.
 /// (OpenVDB's own track() renormalizes the interface voxels too; its smoothed-sign iterations
-/// shift the zero set a little every time — see the header.)
+/// shift the zero set a little every time — see the header.) An interface voxel's true distance
+/// is at most Δx; one whose value says more is stale (the surface swept past it, e.g. a tip
+/// retracting after a pinch-off) and gets the distance estimate of OpenVDB's fast sweeping
+/// (FastSweeping.h InitSdf): along each axis with a sign change the linearly interpolated
+/// crossing distance dₐ, combined as 1/sqrt(Σ 1/dₐ²), exact for a plane.
 void rebuild_band(openvdb::FloatGrid& grid, int iterations) {
     using Tracker = openvdb::tools::LevelSetTracker<openvdb::FloatGrid>;
+    const float dx = static_cast<float>(grid.voxelSize()[0]);
     Tracker band(grid);
     band.setNormCount(iterations);
     openvdb::tools::dilateActiveValues(band.leafs(), 1, openvdb::tools::NN_FACE,
                                        openvdb::tools::IGNORE_TILES);
     Tracker::MaskTreeType free_voxels(grid.tree(), false, openvdb::TopologyCopy());
+    std::vector<std::pair<openvdb::Coord, float>> stale;
     {
         openvdb::FloatGrid::ConstAccessor acc = grid.getConstAccessor();
         auto mask_acc = openvdb::tree::ValueAccessor<Tracker::MaskTreeType>(free_voxels);
         for (auto it = grid.cbeginValueOn(); it; ++it) {
             const openvdb::Coord ijk = it.getCoord();
-            const bool inside = *it < 0.0f;
-            for (int a = 0; a < 3; ++a)
-                for (int s = -1; s <= 1; s += 2) {
+            const float value = *it;
+            const bool inside = value < 0.0f;
+            bool interface = false;
+            double inverse_square_sum = 0.0;
+            for (int a = 0; a < 3; ++a) {
+                double nearest = std::numeric_limits<double>::infinity();  // in voxels
+                for (int side = -1; side <= 1; side += 2) {
                     openvdb::Coord nb = ijk;
-                    nb[a] += s;
-                    if ((acc.getValue(nb) < 0.0f) != inside) {
-                        mask_acc.setValueOff(ijk);
-                        a = 3;
-                        break;
+                    nb[a] += side;
+                    const float other = acc.getValue(nb);
+                    if ((other < 0.0f) != inside) {
+                        interface = true;
+                        nearest = std::min(nearest, static_cast<double>(value) /
+                                                        (static_cast<double>(value) - other));
                     }
                 }
+                if (nearest < std::numeric_limits<double>::infinity() && nearest > 0.0)
+                    inverse_square_sum += 1.0 / (nearest * nearest);
+            }
+            if (!interface)
+                continue;
+            mask_acc.setValueOff(ijk);
+            if (std::abs(value) > dx)
+                stale.emplace_back(ijk, static_cast<float>(std::copysign(
+                                            dx / std::sqrt(inverse_square_sum), value)));
         }
     }
+    openvdb::FloatGrid::Accessor acc = grid.getAccessor();
+    for (const auto& [ijk, value] : stale)
+        acc.setValueOnly(ijk, value);
     band.normalize(&free_voxels);
     band.prune();
 }
@@ -202,7 +229,11 @@ LevelSetReference::LevelSetReference(const tracker::ImplicitShape& shape,
                     stencil.gradient().length() < DEGENERATE_GRADIENT
                         ? static_cast<double>(stencil.laplacian())
                         : 2.0 * static_cast<double>(stencil.meanCurvatureNormGrad());
-                out[it.pos()] = static_cast<float>(static_cast<double>(*it) + dt * speed);
+                // The band follows the surface by one voxel per step: at under-resolved
+                // singular events (curvature beyond 6/Δx) the motion is capped at MAX_STEP_VOXELS.
+                const double move =
+                    std::clamp(dt * speed, -MAX_STEP_VOXELS * dx, MAX_STEP_VOXELS * dx);
+                out[it.pos()] = static_cast<float>(static_cast<double>(*it) + move);
             }
         });
         leafs.swapLeafBuffer(1);

@@ -16,11 +16,14 @@
 /// band voxel, with Δt = cfl · Δx²/6 shortened so that a whole number of steps ends at end_time.
 /// Where the central-difference |∇φ| is below 0.5 (a voxel-sized blob left by a pinch-off, whose
 /// gradient vanishes, would otherwise never move) the step uses Δφ, which equals κ₁ + κ₂ for a
-/// signed distance.
+/// signed distance. A step moves no value by more than Δx/2 (the band follows the surface by
+/// one voxel per step; only curvatures beyond 3/Δx, at under-resolved pinch-offs, reach the cap).
 /// After every step the band is rebuilt around the moved surface WITHOUT moving it: dilate by
 /// one voxel, `renormalization_iterations` Euler steps of the Eikonal equation (OpenVDB's
 /// LevelSetTracker::normalize, HJWENO5 gradients) on every band voxel except the interface
-/// voxels (a face neighbour of the other sign), which keep their values, then trim.
+/// voxels (a face neighbour of the other sign), which keep their values, then trim. An interface
+/// voxel whose |φ| exceeds Δx is stale (the surface swept past it, as a tip does right after a
+/// pinch-off) and first gets the crossing-distance estimate of OpenVDB's fast sweeping.
 ///
 /// Why not `openvdb::tools::LevelSetFilter::meanCurvature()`: it takes the same Euler step with
 /// the mean curvature and a fixed Δt = Δx²/3 (OpenVDB 10 LevelSetFilter.h), i.e. Δx²/6 of the
