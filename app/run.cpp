@@ -101,6 +101,25 @@ public:
 
     bool enabled() const { return m_options.type != "none"; }
 
+    /// Throws InputError if the run ends after the exact surface vanishes (the scene's own end
+    /// time is checked when it is read; --frames can extend it).
+    void check_end(double end_time) const {
+        const double vanishes =
+            m_options.type == "two_sphere_normal_flow"
+                ? m_two_spheres.reversal_time +
+                      (m_two_spheres.initial_radius +
+                       m_two_spheres.speed * m_two_spheres.reversal_time) /
+                          m_two_spheres.speed
+                : 0.25 * m_options.radius * m_options.radius;
+        if (end_time < vanishes)
+            return;
+        std::ostringstream s;
+        s << m_source << ": /flow/exact: the run ends at t = " << end_time
+          << " s, when the exact surface no longer exists (it vanishes at t = " << vanishes
+          << " s): use fewer --frames";
+        throw InputError(s.str());
+    }
+
     /// Throws InputError unless the initial surface is the exact solution at t = 0: every vertex
     /// within INITIAL_VERTEX_TOLERANCE · ξ of it and the enclosed volume within
     /// INITIAL_VOLUME_TOLERANCE of the exact one (so that, say, one sphere of the two fails).
@@ -483,20 +502,22 @@ RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
 RunResult run_scene(const Scene& scene, const RunOptions& options, const std::atomic<bool>& stop) {
     if (scene.flow.type == "fluid")
         return run_fluid_scene(scene, options, stop);
+    const int frames = options.frames > 0 ? options.frames : scene.time.frames;
+    // --frames keeps the time per frame of the scene.
+    const double frame_dt = scene.time.end / scene.time.frames;
+    const double end_time = frame_dt * frames;
+    const ExactSolution exact(scene, end_time);
+    if (exact.enabled())
+        exact.check_end(end_time);
+
     std::string report;
     tracker::SurfaceTracker tracker(build_initial_surface(scene, &report), scene.tracker);
     const SurfaceMesh& mesh = tracker.mesh();
     if (!options.quiet)
         std::fprintf(stderr, "%s: %s\n", scene.name.c_str(), report.c_str());
-
-    const int frames = options.frames > 0 ? options.frames : scene.time.frames;
-    // --frames keeps the time per frame of the scene.
-    const double frame_dt = scene.time.end / scene.time.frames;
-    const double end_time = frame_dt * frames;
-    const GeometricFlow flow = make_flow(scene.flow);
-    const ExactSolution exact(scene, end_time);
     if (exact.enabled())
         exact.check_initial(mesh, tracker.characteristic_length());
+    const GeometricFlow flow = make_flow(scene.flow);
 
     FrameWriter writer(scene, options.out_dir);
     Progress progress(stderr, options.quiet);

@@ -166,7 +166,7 @@ void visit_fields(V& v, tracker::CurlNoiseOptions& o) {
     o.seed = static_cast<std::uint64_t>(seed);
     v.boolean("planar", o.planar,
               "potential (0, 0, φ): motion in planes z = const (paper §4.3's rotation)");
-    v.number("rms_speed", o.rms_speed, Range::positive(), "m/s", "spatial RMS of |u|");
+    v.number("rms_speed", o.rms_speed, Range::positive(), "m/s", "spatial RMS of the speed");
     v.number("base_wavelength", o.base_wavelength, Range::positive(), "m",
              "wavelength of the first octave");
     v.integer("octaves", o.octaves, Range::between(1, 16), "", "octaves of random Fourier modes");

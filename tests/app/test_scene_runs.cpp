@@ -204,6 +204,25 @@ TEST(FlowScenes, OpenSheetKeepsItsBoundaryUnderCurlNoise) {
     fs::remove_all(options.out_dir);
 }
 
+TEST(FlowScenes, ExactSolutionMustOutlastTheRun) {
+    // A1's merged balls (radius 0.4 at t = 1) erode away at t = 3; --frames 40 would run to 4.
+    const Scene scene = load_scene(FLOW_SCENES + "a1_face_offsetting_xi0.04.json");
+    RunOptions options;
+    options.out_dir = (fs::temp_directory_path() / "meniscus_exact_end").string();
+    options.frames = 40;
+    options.quiet = true;
+    const std::atomic<bool> stop{false};
+    try {
+        run_scene(scene, options, stop);
+        ADD_FAILURE() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("/flow/exact: the run ends at t = 4 s"),
+                  std::string::npos)
+            << e.what();
+    }
+    fs::remove_all(options.out_dir);
+}
+
 TEST(FlowScenes, ExactSolutionMustMatchTheInitialSurface) {
     // One sphere where /flow/exact describes two: refused before any step.
     Scene scene = parse_scene(R"({"surface": {"edge_length": 0.05,
