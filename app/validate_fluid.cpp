@@ -1,14 +1,13 @@
 /// Part B of `meniscus validate`: two-phase flow with surface tension (VALIDATION.md B1–B5).
-/// B1–B4 drive a coupling::Simulation step by step and measure the mesh after every step; B5
-/// runs the shipped merge and pinch scenes through run_scene() exactly as `meniscus run` does,
-/// with the exact self-intersection test after every step, and reads their stats.jsonl.
+/// B1–B4 drive a coupling::Simulation step by step and measure the mesh after every step
+/// (app/fluid_measures.h); B5 runs the shipped merge and pinch scenes through run_scene() exactly
+/// as `meniscus run` does, with the exact self-intersection test after every step, and reads
+/// their stats.jsonl.
 
 #include "app/validate_fluid.h"
 
+#include "app/fluid_measures.h"
 #include "app/run.h"
-#include "tracker/mesh_measures.h"
-
-#include <Eigen/Dense>
 
 #include <algorithm>
 #include <atomic>
@@ -17,7 +16,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -43,301 +41,7 @@ std::string percent(double measured, double reference) {
     return fmt(100.0 * (measured / reference - 1.0), "%+.2f %%");
 }
 
-/// Golden-section minimum of f on [a, b] (f unimodal there).
-template <class F>
-double golden_minimum(F&& f, double a, double b, int iterations) {
-    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-    double c = b - g * (b - a), d = a + g * (b - a);
-    double fc = f(c), fd = f(d);
-    for (int i = 0; i < iterations; ++i) {
-        if (fc < fd) {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
-    return 0.5 * (a + b);
-}
-
-/// Least squares y ≈ X·c; returns c and writes the residual sum of squares.
-Eigen::VectorXd least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, double* rss) {
-    const Eigen::VectorXd c = x.colPivHouseholderQr().solve(y);
-    if (rss)
-        *rss = (x * c - y).squaredNorm();
-    return c;
-}
-
-/// Fits y = m + a cos(k(s − s0)) + b sin(k(s − s0)) over the given samples.
-ModeFit fit_mode(const std::vector<double>& s, const std::vector<double>& h, double s0, double k) {
-    if (s.size() < 3)
-        return {};
-    Eigen::MatrixXd x(static_cast<Eigen::Index>(s.size()), 3);
-    Eigen::VectorXd y(static_cast<Eigen::Index>(s.size()));
-    for (size_t i = 0; i < s.size(); ++i) {
-        const auto r = static_cast<Eigen::Index>(i);
-        x(r, 0) = 1.0;
-        x(r, 1) = std::cos(k * (s[i] - s0));
-        x(r, 2) = std::sin(k * (s[i] - s0));
-        y(r) = h[i];
-    }
-    const Eigen::VectorXd c = least_squares(x, y, nullptr);
-    return {c(0), c(1), c(2)};
-}
-
 }  // namespace
-
-// ---- Running ----------------------------------------------------------------------------------
-
-coupling::Simulation make_fluid_simulation(const Scene& scene) {
-    tracker::SurfaceMesh initial = build_initial_surface(scene);
-    const double dx = scene.domain.size.x() / scene.domain.cells;
-    const auto cells_along = [&](double size) {
-        return std::max(1, static_cast<int>(std::lround(size / dx)));
-    };
-    fluid::FluidSolver solver(scene.domain.cells, cells_along(scene.domain.size.y()),
-                              cells_along(scene.domain.size.z()), dx, scene.domain.min,
-                              scene.fluid);
-    return coupling::Simulation(tracker::SurfaceTracker(std::move(initial), scene.tracker),
-                                std::move(solver), scene.coupling.simulation);
-}
-
-FluidRunRecord run_sampled(coupling::Simulation& sim, double end_time,
-                           const std::function<void(const coupling::Simulation&)>& sample,
-                           long long max_steps) {
-    const auto start = Clock::now();
-    FluidRunRecord r;
-    const auto record = [&](int intersecting) {
-        const tracker::SurfaceMesh& mesh = sim.tracker().mesh();
-        r.t.push_back(sim.time());
-        r.components.push_back(tracker::triangle_components(mesh).count);
-        r.enclosed_volume.push_back(tracker::enclosed_volume(mesh));
-        r.intersecting_pairs.push_back(intersecting);
-        r.max_speed.push_back(sim.fluid().grid().max_abs_velocity().maxCoeff());
-        if (sample)
-            sample(sim);
-    };
-    record(-1);
-    while (sim.time() < end_time * (1.0 - 1e-12)) {
-        if (max_steps > 0 && r.steps >= max_steps) {
-            r.wall_seconds = seconds_since(start);
-            return r;
-        }
-        const coupling::SimulationStepReport s = sim.step(end_time - sim.time());
-        ++r.steps;
-        r.pressure_converged = r.pressure_converged && s.fluid.pressure.converged;
-        r.max_intersecting_pairs = std::max(r.max_intersecting_pairs, s.integrate.intersecting_pairs);
-        r.merges += s.volume.merges;
-        r.splits += s.volume.splits;
-        record(s.integrate.intersecting_pairs);
-        if (!(s.integrate.time_advanced > 0.0))
-            break;  // a stalled step: reported as not completed
-    }
-    r.completed = sim.time() >= end_time * (1.0 - 1e-12);
-    r.wall_seconds = seconds_since(start);
-    return r;
-}
-
-// ---- Measurements -----------------------------------------------------------------------------
-
-VolumeMoments volume_moments(const tracker::SurfaceMesh& mesh) {
-    // Signed tetrahedra (0, p0, p1, p2): volume V_t = p0·(p1×p2)/6, ∫x dV = V_t Σp/4,
-    // ∫x_d² dV = V_t/10 (Σ p_d² + Σ_{i<j} p_i,d p_j,d) (the origin vertex adds nothing).
-    // Computed about a reference point near the mesh to limit cancellation.
-    Vector3d ref = Vector3d::Zero();
-    int n = 0;
-    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
-        if (mesh.vertex_alive(vi)) {
-            ref += mesh.position(vi);
-            ++n;
-        }
-    if (n == 0)
-        return {};
-    ref /= n;
-    double volume = 0.0;
-    Vector3d first = Vector3d::Zero(), second = Vector3d::Zero();
-    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
-        if (!mesh.triangle_alive(ti))
-            continue;
-        const tracker::Triangle& tri = mesh.triangle(ti);
-        const Vector3d p0 = mesh.position(tri[0]) - ref, p1 = mesh.position(tri[1]) - ref,
-                       p2 = mesh.position(tri[2]) - ref;
-        const double v = p0.dot(p1.cross(p2)) / 6.0;
-        volume += v;
-        first += v * (p0 + p1 + p2) / 4.0;
-        second += v / 10.0 *
-                  (p0.cwiseProduct(p0) + p1.cwiseProduct(p1) + p2.cwiseProduct(p2) +
-                   p0.cwiseProduct(p1) + p0.cwiseProduct(p2) + p1.cwiseProduct(p2));
-    }
-    VolumeMoments m;
-    m.volume = volume;
-    const Vector3d c = first / volume;
-    m.centroid = ref + c;
-    const Vector3d central = second / volume - c.cwiseProduct(c);
-    m.semi_axes = (5.0 * central.cwiseMax(0.0)).cwiseSqrt();
-    return m;
-}
-
-ModeFit column_radius_mode(const tracker::SurfaceMesh& mesh, const Eigen::Vector2d& axis_yz,
-                           double x0, double wavelength, double x_lo, double x_hi) {
-    std::vector<double> s, r;
-    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
-        if (!mesh.vertex_alive(vi))
-            continue;
-        const Vector3d& p = mesh.position(vi);
-        if (p.x() < x_lo || p.x() > x_hi)
-            continue;
-        s.push_back(p.x());
-        r.push_back(std::hypot(p.y() - axis_yz.x(), p.z() - axis_yz.y()));
-    }
-    return fit_mode(s, r, x0, 2.0 * M_PI / wavelength);
-}
-
-ModeFit surface_height_mode(const tracker::SurfaceMesh& mesh, const Vector3d& lo,
-                            const Vector3d& hi, double z_min, double x0, double wavelength) {
-    std::vector<double> s, z;
-    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
-        if (!mesh.vertex_alive(vi))
-            continue;
-        const Vector3d& p = mesh.position(vi);
-        if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any() || p.z() < z_min)
-            continue;
-        s.push_back(p.x());
-        z.push_back(p.z());
-    }
-    return fit_mode(s, z, x0, 2.0 * M_PI / wavelength);
-}
-
-// ---- Fits -------------------------------------------------------------------------------------
-
-OscillationFit fit_damped_oscillation(const std::vector<double>& t, const std::vector<double>& y,
-                                      double omega_min, double omega_max) {
-    if (t.size() != y.size() || t.size() < 6)
-        throw std::invalid_argument("fit_damped_oscillation: need ≥ 6 samples of t and y");
-    if (!(omega_min > 0.0 && omega_max > omega_min))
-        throw std::invalid_argument("fit_damped_oscillation: need 0 < omega_min < omega_max");
-    const auto n = static_cast<Eigen::Index>(t.size());
-    const Eigen::VectorXd yv = Eigen::Map<const Eigen::VectorXd>(y.data(), n);
-    const auto solve = [&](double omega, double gamma, double* rss) {
-        Eigen::MatrixXd x(n, 3);
-        for (Eigen::Index i = 0; i < n; ++i) {
-            const double ti = t[static_cast<size_t>(i)], e = std::exp(-gamma * ti);
-            x(i, 0) = 1.0;
-            x(i, 1) = e * std::cos(omega * ti);
-            x(i, 2) = e * std::sin(omega * ti);
-        }
-        return least_squares(x, yv, rss);
-    };
-    constexpr int GOLDEN_ITERATIONS = 60;
-    const double gamma_bound = omega_min;
-    const auto best_gamma = [&](double omega) {
-        return golden_minimum(
-            [&](double gamma) {
-                double rss = 0.0;
-                solve(omega, gamma, &rss);
-                return rss;
-            },
-            -gamma_bound, gamma_bound, GOLDEN_ITERATIONS);
-    };
-    const auto rss_at = [&](double omega) {
-        double rss = 0.0;
-        solve(omega, best_gamma(omega), &rss);
-        return rss;
-    };
-    // Coarse scan (the residual has side minima), then golden section around the best.
-    constexpr int SCAN = 200;
-    const double step = (omega_max - omega_min) / SCAN;
-    double best = omega_min, best_rss = std::numeric_limits<double>::infinity();
-    for (int i = 0; i <= SCAN; ++i) {
-        const double omega = omega_min + i * step;
-        const double rss = rss_at(omega);
-        if (rss < best_rss) {
-            best_rss = rss;
-            best = omega;
-        }
-    }
-    OscillationFit fit;
-    fit.omega = golden_minimum(rss_at, std::max(omega_min, best - step),
-                               std::min(omega_max, best + step), GOLDEN_ITERATIONS);
-    fit.decay_rate = best_gamma(fit.omega);
-    double rss = 0.0;
-    const Eigen::VectorXd c = solve(fit.omega, fit.decay_rate, &rss);
-    fit.offset = c(0);
-    fit.cos_coefficient = c(1);
-    fit.sin_coefficient = c(2);
-    fit.amplitude = std::hypot(c(1), c(2));
-    fit.rms_residual = std::sqrt(rss / static_cast<double>(n));
-    return fit;
-}
-
-GrowthFit fit_growth_from_rest(const std::vector<double>& t, const std::vector<double>& y,
-                               double rate_min, double rate_max) {
-    if (t.size() != y.size() || t.size() < 4)
-        throw std::invalid_argument("fit_growth_from_rest: need ≥ 4 samples of t and y");
-    if (!(rate_min > 0.0 && rate_max > rate_min))
-        throw std::invalid_argument("fit_growth_from_rest: need 0 < rate_min < rate_max");
-    const auto n = static_cast<Eigen::Index>(t.size());
-    const auto solve = [&](double s, double* rss) {
-        Eigen::MatrixXd x(n, 2);
-        Eigen::VectorXd rhs(n);
-        for (Eigen::Index i = 0; i < n; ++i) {
-            const double ti = t[static_cast<size_t>(i)], w = 1.0 / y[static_cast<size_t>(i)];
-            x(i, 0) = w * std::exp(s * ti);
-            x(i, 1) = w * std::exp(-s * ti);
-            rhs(i) = 1.0;
-        }
-        return least_squares(x, rhs, rss);
-    };
-    const auto rss_at = [&](double s) {
-        double rss = 0.0;
-        solve(s, &rss);
-        return rss;
-    };
-    constexpr int SCAN = 200;
-    constexpr int GOLDEN_ITERATIONS = 60;
-    const double step = (rate_max - rate_min) / SCAN;
-    double best = rate_min, best_rss = std::numeric_limits<double>::infinity();
-    for (int i = 0; i <= SCAN; ++i) {
-        const double rss = rss_at(rate_min + i * step);
-        if (rss < best_rss) {
-            best_rss = rss;
-            best = rate_min + i * step;
-        }
-    }
-    GrowthFit fit;
-    fit.rate = golden_minimum(rss_at, std::max(rate_min, best - step),
-                              std::min(rate_max, best + step), GOLDEN_ITERATIONS);
-    double rss = 0.0;
-    const Eigen::VectorXd c = solve(fit.rate, &rss);
-    fit.a_plus = c(0);
-    fit.a_minus = c(1);
-    fit.rms_relative_residual = std::sqrt(rss / static_cast<double>(n));
-    return fit;
-}
-
-// ---- References -------------------------------------------------------------------------------
-
-double lamb_omega(int l, double sigma, double radius, double rho_inside, double rho_outside) {
-    const double num = l * (l + 1.0) * (l - 1.0) * (l + 2.0) * sigma;
-    const double den = radius * radius * radius * ((l + 1.0) * rho_inside + l * rho_outside);
-    return std::sqrt(num / den);
-}
-
-double rayleigh_plateau_rate(double sigma, double rho, double radius, double k) {
-    const double x = k * radius;
-    if (x >= 1.0)
-        return 0.0;
-    const double w2 = sigma / (rho * radius * radius * radius) * x * (1.0 - x * x) *
-                      std::cyl_bessel_i(1.0, x) / std::cyl_bessel_i(0.0, x);
-    return std::sqrt(w2);
-}
 
 bool is_fluid_case(const std::string& id) {
     return id == "B1" || id == "B2" || id == "B3" || id == "B4" || id == "B5";
@@ -362,8 +66,12 @@ constexpr double JET_BOX = 0.003;  ///< cross-section edge, m
 constexpr double JET_EPSILON = 0.01;
 /// The linear regime of B3: amplitudes below this fraction of R enter the growth fit.
 constexpr double LINEAR_AMPLITUDE_FRACTION = 0.1;
-/// The closed slab and the perturbed column extend this many cells beyond the walls they cross.
-constexpr double WALL_OVERLAP_CELLS = 2.0;
+/// The closed slab and the perturbed column extend this many cells beyond the walls they cross,
+/// where a box cuts them: the cut's sharp rim (and its curvature, spread by smoothing passes)
+/// must stay well away from the grid faces next to the wall. (With 2 cells and 2 smoothing
+/// passes the rim's curvature reached the wall faces: at R = 3 cells the 1 % perturbation of
+/// B3 shrank and reversed sign instead of growing.)
+constexpr double WALL_OVERLAP_CELLS = 6.0;
 /// B4 (VALIDATION.md): σ = 1, ρ₁ = ρ₂ = 1, λ = 1, amplitude 0.01λ, inviscid.
 constexpr double WAVE_LAMBDA = 1.0;
 constexpr double WAVE_AMPLITUDE = 0.01;
@@ -628,8 +336,8 @@ struct Runner {
     // ---- B3 ----
     void b3(std::ostringstream& md) {
         // One wavelength, wall to wall, bulges at both walls and the neck in the middle (free-
-        // slip walls are mirror planes); the column crosses the end walls by 2 cells and is
-        // cut there by a box (outside the domain).
+        // slip walls are mirror planes); the column crosses the end walls by
+        // WALL_OVERLAP_CELLS and is cut there by a box (outside the domain).
         const int cells = options.full ? 54 : 27;  // R = 6 (full) or 3 (quick) cells
         const double dx = JET_WAVELENGTH / cells;
         const double k = 2.0 * M_PI / JET_WAVELENGTH;
@@ -809,7 +517,7 @@ struct Runner {
               "domain x ∈ [0, λ] between free-slip walls (a cos(2πx/λ) mode is symmetric about "
               "both), " << WAVE_THICKNESS_CELLS
            << " cells thick in y, mean interface at depth λ/2 in a box of height λ. The liquid "
-              "slab is the wavy half-space cut by a box reaching 2 cells beyond the side and "
+              "slab is the wavy half-space cut by a box reaching 6 cells beyond the side and "
               "bottom walls (vertices outside the domain take the velocity at the clamped point). "
               "Amplitude a(t): least-squares cos(kx) mode of the top surface's vertices in the "
               "domain, fitted over "

@@ -3,119 +3,15 @@
 /// tension): B1 static drop (Laplace jump, spurious currents), B2 oscillating drop (Lamb's
 /// frequency and damping), B3 Rayleigh–Plateau (linear growth rate, pinch-off), B4 capillary
 /// wave (frequency against ω₀² = σk³/(ρ₁+ρ₂)), B5 merge and pinch scenes (component counts,
-/// volume of each phase, intersections). Also the measurement helpers those cases and the scene
-/// physics tests share: coupled runs sampled every step, mesh moments and mode amplitudes, and
-/// least-squares fits of oscillations and exponential growth.
+/// volume of each phase, intersections). The measurements are in app/fluid_measures.h.
 
-#include "app/scene.h"
-#include "coupling/simulation.h"
-#include "tracker/mesh.h"
-
-#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
-#include <functional>
 #include <string>
 #include <vector>
 
 namespace meniscus::app {
-
-// ---- Running a fluid scene step by step ------------------------------------------------------
-
-/// The coupled simulation of a fluid scene set up as `meniscus run` sets it up (grid from
-/// /domain, initial surface from /surface with the /surface/inside labels). /initial_velocity
-/// is not applied: the fluid starts at rest. Throws what build_initial_surface() throws.
-coupling::Simulation make_fluid_simulation(const Scene& scene);
-
-/// What a sampled run recorded after every step (index 0: the initial state).
-struct FluidRunRecord {
-    std::vector<double> t;                ///< s
-    std::vector<int> components;          ///< connected components of the surface
-    std::vector<double> enclosed_volume;  ///< m³, volume enclosed by the surface
-    std::vector<int> intersecting_pairs;  ///< exact check after each step (−1 = not checked)
-    std::vector<double> max_speed;        ///< max |u| over the grid's faces, m/s
-    long long steps = 0;
-    bool completed = false;      ///< reached the end time
-    bool pressure_converged = true;  ///< every pressure solve converged
-    int max_intersecting_pairs = 0;
-    int merges = 0;
-    int splits = 0;
-    double wall_seconds = 0.0;
-};
-
-/// Steps `sim` until `end_time` (s), calling `sample` after every step (and once before the
-/// first), recording the series above. Stops early (completed = false) after `max_steps` steps
-/// when max_steps > 0.
-FluidRunRecord run_sampled(coupling::Simulation& sim, double end_time,
-                           const std::function<void(const coupling::Simulation&)>& sample,
-                           long long max_steps = 0);
-
-// ---- Measurements on the mesh ----------------------------------------------------------------
-
-/// Volume enclosed by a closed mesh and its second moments about the centroid.
-struct VolumeMoments {
-    double volume = 0.0;                                 ///< m³
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< m
-    /// Semi-axes (m) of the axis-aligned ellipsoid with the same volume moments:
-    /// sqrt(5 ∫(x_d − c_d)² dV / V) along each axis d (exact for such an ellipsoid).
-    Eigen::Vector3d semi_axes = Eigen::Vector3d::Zero();
-};
-/// Exact volume integrals over the closed mesh (signed tetrahedra from the origin).
-VolumeMoments volume_moments(const tracker::SurfaceMesh& mesh);
-
-/// Fourier mode of a surface: least-squares fit h = mean + a·cos(k(s − s0)) + b·sin(k(s − s0)).
-struct ModeFit {
-    double mean = 0.0;
-    double cos_amplitude = 0.0;  ///< a
-    double sin_amplitude = 0.0;  ///< b
-};
-/// Radius of a column along x about the axis (y, z) = axis_yz: fit over the live vertices with
-/// x in [x_lo, x_hi] of r = mean + a cos(2π(x − x0)/λ) + b sin(…).
-ModeFit column_radius_mode(const tracker::SurfaceMesh& mesh, const Eigen::Vector2d& axis_yz,
-                           double x0, double wavelength, double x_lo, double x_hi);
-/// Height of a wavy surface z(x): fit over the live vertices inside the box [lo, hi] with z above
-/// z_min of z = mean + a cos(2π(x − x0)/λ) + b sin(…).
-ModeFit surface_height_mode(const tracker::SurfaceMesh& mesh, const Eigen::Vector3d& lo,
-                            const Eigen::Vector3d& hi, double z_min, double x0, double wavelength);
-
-// ---- Fits --------------------------------------------------------------------------------------
-
-/// y(t) ≈ offset + e^{−γt} (A cos ωt + B sin ωt), least squares: A, B and the offset are linear,
-/// ω and γ are found by nested golden-section searches.
-struct OscillationFit {
-    double omega = 0.0;       ///< rad/s
-    double decay_rate = 0.0;  ///< γ, 1/s (the amplitude decays as e^{−γt})
-    double offset = 0.0;
-    double cos_coefficient = 0.0;  ///< A
-    double sin_coefficient = 0.0;  ///< B
-    double amplitude = 0.0;        ///< sqrt(A² + B²)
-    double rms_residual = 0.0;
-};
-/// Fits over all samples; ω is searched in [omega_min, omega_max], γ in [−omega_min, omega_min].
-/// Throws std::invalid_argument with fewer than 6 samples or a bad range.
-OscillationFit fit_damped_oscillation(const std::vector<double>& t, const std::vector<double>& y,
-                                      double omega_min, double omega_max);
-
-/// y(t) ≈ A e^{st} + B e^{−st} (the linear Rayleigh–Plateau amplitude from rest), least squares
-/// relative to y; s searched in [rate_min, rate_max] by golden section.
-struct GrowthFit {
-    double rate = 0.0;  ///< s, 1/s
-    double a_plus = 0.0;
-    double a_minus = 0.0;
-    double rms_relative_residual = 0.0;
-};
-GrowthFit fit_growth_from_rest(const std::vector<double>& t, const std::vector<double>& y,
-                               double rate_min, double rate_max);
-
-// ---- References --------------------------------------------------------------------------------
-
-/// Lamb's inviscid frequency (rad/s) of mode l of a drop of radius R (m), density ρ_i inside and
-/// ρ_o outside: ω² = l(l+1)(l−1)(l+2) σ / (R³ [(l+1) ρ_i + l ρ_o]).
-double lamb_omega(int l, double sigma, double radius, double rho_inside, double rho_outside);
-/// Rayleigh's inviscid growth rate (1/s) of a column of radius R at wavenumber k:
-/// ω² = σ/(ρR³) · x(1−x²) I₁(x)/I₀(x), x = kR (0 for x ≥ 1).
-double rayleigh_plateau_rate(double sigma, double rho, double radius, double k);
 
 // ---- The validation cases ------------------------------------------------------------------------
 
