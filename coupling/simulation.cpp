@@ -14,6 +14,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// Cap on a vertex's sub-grid displacement per step, in mesh edge lengths: the damping is meant
+/// for mesh-scale wrinkles; a sliver's outsized cotangent weights must not throw a vertex far.
+constexpr double MAX_SUBGRID_STEP_EDGES = 0.25;
+
 double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -117,12 +121,35 @@ SimulationStepReport Simulation::step(double max_dt) {
     // (6) Volume correction rides on the collision-safe motion; (5) integrate.
     start = Clock::now();
     std::vector<tracker::Vec3> velocities = m_vertex_velocities;
+    add_subgrid_tension(velocities, report.dt);
     if (m_volumes)
         m_volumes->add_correction(velocities, report.dt);
     report.integrate = m_tracker->integrate(velocities, report.dt);
     report.tracker_seconds += seconds_since(start);
     m_time += report.integrate.time_advanced;
     return report;
+}
+
+void Simulation::add_subgrid_tension(std::vector<tracker::Vec3>& velocities, double dt) const {
+    const SurfaceTensionOptions& options = m_options.surface_tension;
+    const fluid::PhaseOptions& phases = m_fluid.options().phases;
+    const tracker::SurfaceMesh& mesh = m_tracker->mesh();
+    if (options.subgrid_rate == 0.0 || phases.sigma == 0.0 || mesh.count_live_triangles() == 0)
+        return;
+    // D = β h² / t_h with t_h = sqrt(ρ̄ h³ / (2πσ)), the capillary time of the mesh scale h.
+    const double h = tracker::edge_length_stats(mesh).mean;
+    const double rho_mean = m_fluid.options().mode == fluid::FluidMode::two_phase
+                                ? 0.5 * (phases.rho_liquid + phases.rho_gas)
+                                : 0.5 * phases.rho_liquid;
+    const double t_h = std::sqrt(rho_mean * h * h * h / (2.0 * M_PI * phases.sigma));
+    const double diffusivity = options.subgrid_rate * h * h / t_h;
+    const std::vector<tracker::Vec3> subgrid =
+        subgrid_tension_velocities(mesh, diffusivity, options.subgrid_resolved_passes);
+    const double max_speed = MAX_SUBGRID_STEP_EDGES * h / dt;
+    for (size_t v = 0; v < velocities.size(); ++v) {
+        const double speed = subgrid[v].norm();
+        velocities[v] += speed > max_speed ? (max_speed / speed) * subgrid[v] : subgrid[v];
+    }
 }
 
 double Simulation::kinetic_energy() const {

@@ -2,8 +2,9 @@
 /// \file One coupled step of liquid/gas flow with an explicit interface (DESIGN.md coupling):
 /// (1) Δt from CFL, the capillary limit (with the smaller of Δx and the mesh's mean edge
 /// length) and the time left to the frame; (2) mesh → φ at cell centres and κ at crossed faces;
-/// (3) the fluid step; (4) grid velocity → mesh vertices; (5) the tracker's improve(),
-/// change_topology() and collision-safe integrate(); (6) optional volume correction per
+/// (3) the fluid step; (4) grid velocity → mesh vertices, plus the sub-grid surface-tension
+/// velocity that damps mesh-scale wrinkles (subgrid_tension_velocities()); (5) the tracker's
+/// improve(), change_topology() and collision-safe integrate(); (6) optional volume correction per
 /// connected component (through merges and pinch-offs).
 
 #include "coupling/interpolate.h"
@@ -62,12 +63,17 @@ public:
     const tracker::SurfaceTracker& tracker() const { return *m_tracker; }
     const fluid::FluidSolver& fluid() const { return m_fluid; }
     double time() const { return m_time; }
-    /// Per-vertex velocities of the last step (sized mesh().num_vertices()), m/s.
+    /// Per-vertex velocities of the last step interpolated from the grid (sized
+    /// mesh().num_vertices()), m/s; without the sub-grid and volume-correction terms.
     const std::vector<tracker::Vec3>& vertex_velocities() const { return m_vertex_velocities; }
     /// Kinetic energy ½ Σ ρ u² dV over the grid's faces (J), liquid and gas by φ.
     double kinetic_energy() const;
 
 private:
+    /// Adds the sub-grid surface-tension velocity (subgrid_tension_velocities(), rate from
+    /// options.surface_tension) to `velocities`, each capped at a quarter edge per `dt`.
+    void add_subgrid_tension(std::vector<tracker::Vec3>& velocities, double dt) const;
+
     std::unique_ptr<tracker::SurfaceTracker> m_tracker;  // stable address for the observer
     fluid::FluidSolver m_fluid;
     SimulationOptions m_options;

@@ -22,6 +22,11 @@ namespace {
 using tracker::SurfaceMesh;
 using tracker::Vec3;
 
+/// Upper bound of SurfaceTensionOptions::subgrid_rate: D Δt ≤ β h² stays below the explicit
+/// cotangent Laplacian's stability limit (about h²/3 on an equilateral mesh) with room for
+/// irregular triangles.
+constexpr double MAX_SUBGRID_RATE = 0.2;
+
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -70,6 +75,34 @@ void SurfaceTensionOptions::validate() const {
     if (smoothing_passes < 0)
         throw std::invalid_argument("smoothing_passes: expected an integer >= 0, got " +
                                     std::to_string(smoothing_passes));
+    if (!(subgrid_rate >= 0.0 && subgrid_rate <= MAX_SUBGRID_RATE))
+        throw std::invalid_argument("subgrid_rate: expected a number in [0, " +
+                                    std::to_string(MAX_SUBGRID_RATE) + "], got " +
+                                    std::to_string(subgrid_rate));
+    if (subgrid_resolved_passes < 1)
+        throw std::invalid_argument("subgrid_resolved_passes: expected an integer >= 1, got " +
+                                    std::to_string(subgrid_resolved_passes));
+}
+
+std::vector<tracker::Vec3> subgrid_tension_velocities(const tracker::SurfaceMesh& mesh,
+                                                      double diffusivity, int resolved_passes) {
+    if (!(diffusivity >= 0.0))
+        throw std::invalid_argument("subgrid_tension_velocities: diffusivity must be >= 0");
+    if (resolved_passes < 1)
+        throw std::invalid_argument("subgrid_tension_velocities: resolved_passes must be >= 1");
+    const std::vector<Vec3> curvature_normal = tracker::mean_curvature_normals(mesh);
+    std::vector<Vec3> velocities(curvature_normal.size(), Vec3::Zero());
+    if (diffusivity == 0.0)
+        return velocities;
+    std::vector<double> component(curvature_normal.size());
+    for (int axis = 0; axis < 3; ++axis) {
+        for (size_t v = 0; v < component.size(); ++v)
+            component[v] = curvature_normal[v][axis];
+        const std::vector<double> resolved = smooth_vertex_values(mesh, component, resolved_passes);
+        for (size_t v = 0; v < component.size(); ++v)
+            velocities[v][axis] = -diffusivity * (component[v] - resolved[v]);
+    }
+    return velocities;
 }
 
 std::vector<double> smooth_vertex_values(const tracker::SurfaceMesh& mesh,

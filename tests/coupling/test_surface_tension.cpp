@@ -6,6 +6,7 @@
 #include "tracker/flows/mean_curvature.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/implicit_shape.h"
+#include "tracker/mesh_measures.h"
 
 #include <gtest/gtest.h>
 
@@ -228,6 +229,67 @@ TEST(SurfaceTension, SmoothingKeepsTheCapillaryForceOnMeshScaleWrinklesRestoring
     }
 }
 
+TEST(SurfaceTension, SubgridTensionFlattensMeshScaleWrinklesAndSparesTheSphere) {
+    // The sub-grid velocity −D (K − S(K)) is mean-curvature flow restricted to what S removes:
+    // a mesh-scale wrinkle decays, the sphere itself (K resolved) hardly moves and the volume
+    // stays put.
+    const double radius = 0.3;
+    const double edge = 1.0 / 32;
+    const Vector3d centre = Vector3d::Constant(0.5);
+    const tracker::SurfaceMesh sphere = sphere_mesh(centre, radius, edge);
+    const int passes = SurfaceTensionOptions{}.subgrid_resolved_passes;
+    const double diffusivity = 1.0;
+    const double dt = 0.05 * edge * edge / diffusivity;  // rate β = D Δt / h² = 0.05 per step
+    // On the smooth sphere the sub-grid speed is a small fraction of the full flow speed κ·D.
+    double sphere_speed = 0.0;
+    for (const tracker::Vec3& v : subgrid_tension_velocities(sphere, diffusivity, passes))
+        sphere_speed = std::max(sphere_speed, v.norm());
+    std::printf("sub-grid speed on a sphere: %.4f of the mean-curvature flow speed\n",
+                sphere_speed / (diffusivity * 2.0 / radius));
+    EXPECT_LT(sphere_speed, 0.1 * diffusivity * 2.0 / radius);
+
+    // Wrinkle: the roughest vertex pattern, 10 % of an edge radially.
+    const std::vector<double> pattern = roughest_pattern(sphere);
+    double largest = 0.0;
+    for (double value : pattern)
+        largest = std::max(largest, std::abs(value));
+    tracker::SurfaceMesh wrinkled = sphere;
+    for (int vi = 0; vi < sphere.num_vertices(); ++vi) {
+        const Vector3d outward = (sphere.position(vi) - centre).normalized();
+        wrinkled.set_position(vi, sphere.position(vi) + 0.1 * edge *
+                                                            pattern[static_cast<size_t>(vi)] /
+                                                            largest * outward);
+    }
+    const auto rms_radial_error = [&](const tracker::SurfaceMesh& mesh) {
+        double sum = 0.0;
+        for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+            const double error =
+                (mesh.position(vi) - centre).norm() - (sphere.position(vi) - centre).norm();
+            sum += error * error;
+        }
+        return std::sqrt(sum / mesh.num_vertices());
+    };
+    const double error0 = rms_radial_error(wrinkled);
+    const double volume0 = tracker::enclosed_volume(wrinkled);
+    const int steps = 20;
+    for (int step = 0; step < steps; ++step) {
+        const std::vector<tracker::Vec3> velocity =
+            subgrid_tension_velocities(wrinkled, diffusivity, passes);
+        for (int vi = 0; vi < wrinkled.num_vertices(); ++vi)
+            wrinkled.set_position(vi,
+                                  wrinkled.position(vi) + dt * velocity[static_cast<size_t>(vi)]);
+    }
+    const double error1 = rms_radial_error(wrinkled);
+    std::printf(
+        "mesh-scale wrinkle: rms radial deviation %.3g -> %.3g edges in %d steps, volume "
+        "change %.2e\n",
+        error0 / edge, error1 / edge, steps, tracker::enclosed_volume(wrinkled) / volume0 - 1.0);
+    EXPECT_LT(error1, 0.2 * error0);
+    EXPECT_NEAR(tracker::enclosed_volume(wrinkled), volume0, 2e-3 * volume0);
+    EXPECT_THROW(subgrid_tension_velocities(sphere, -1.0, passes), std::invalid_argument);
+    EXPECT_THROW(subgrid_tension_velocities(sphere, 1.0, 0), std::invalid_argument);
+}
+
 TEST(SurfaceTension, BubbleHasNegativeCurvature) {
     const int n = 24;
     const double radius = 0.3;
@@ -324,6 +386,14 @@ TEST(SurfaceTension, StaticDropThroughTheFluidSolverHasTheLaplaceJump) {
 TEST(SurfaceTension, InvalidOptionsAndMismatchedRasterAreRejected) {
     SurfaceTensionOptions options;
     options.smoothing_passes = -1;
+    EXPECT_THROW(options.validate(), std::invalid_argument);
+    options = SurfaceTensionOptions{};
+    options.subgrid_rate = -0.1;
+    EXPECT_THROW(options.validate(), std::invalid_argument);
+    options.subgrid_rate = 1.0;  // above the explicit flow's stability bound
+    EXPECT_THROW(options.validate(), std::invalid_argument);
+    options = SurfaceTensionOptions{};
+    options.subgrid_resolved_passes = 0;
     EXPECT_THROW(options.validate(), std::invalid_argument);
     const fluid::MacGrid grid(8, 8, 8, 0.125);
     const fluid::MacGrid other(9, 8, 8, 0.125);
