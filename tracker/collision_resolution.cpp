@@ -311,16 +311,14 @@ private:
               double target, std::vector<Contact>& out) const {
         const auto p0 = [&](int k) -> const Vec3& { return m_x0[static_cast<size_t>(v[k])]; };
         const auto p1 = [&](int k) -> const Vec3& { return x1[static_cast<size_t>(v[k])]; };
-        const bool hit =
-            edge_edge ? edge_edge_ccd(p0(0), p0(1), p0(2), p0(3), p1(0), p1(1), p1(2), p1(3))
-                      : point_triangle_ccd(p0(0), p0(1), p0(2), p0(3), p1(0), p1(1), p1(2), p1(3));
-        if (!hit)
-            return;
+        // One detailed query: its may_collide is the boolean query's answer (ccd.h), and a hit
+        // is not searched twice (true contacts are the expensive CCD queries).
         const CcdResult r = edge_edge ? edge_edge_ccd_detailed(p0(0), p0(1), p0(2), p0(3), p1(0),
                                                                p1(1), p1(2), p1(3))
                                       : point_triangle_ccd_detailed(p0(0), p0(1), p0(2), p0(3),
                                                                     p1(0), p1(1), p1(2), p1(3));
-        out.push_back({v, r.weights, r.normal, target});
+        if (r.may_collide)
+            out.push_back({v, r.weights, r.normal, target});
     }
 
     static int find(std::vector<int>& parent, int v) {

@@ -89,6 +89,13 @@ std::vector<std::vector<int>> vertex_fans(const SurfaceMesh& mesh, int vi) {
             parent[static_cast<size_t>(a)] = b;
         }
     }
+    // The common case, one fan, without grouping.
+    const int first_root = tris.empty() ? 0 : find_root(parent, 0);
+    bool single_fan = true;
+    for (size_t k = 1; k < tris.size() && single_fan; ++k)
+        single_fan = find_root(parent, static_cast<int>(k)) == first_root;
+    if (single_fan)
+        return tris.empty() ? std::vector<std::vector<int>>{} : std::vector<std::vector<int>>{tris};
     std::map<int, std::vector<int>> groups;
     for (size_t k = 0; k < tris.size(); ++k)
         groups[find_root(parent, static_cast<int>(k))].push_back(tris[k]);
