@@ -140,11 +140,11 @@ struct Runner {
     void b1(std::ostringstream& md) {
         const std::vector<int> resolutions =
             options.full ? std::vector<int>{10, 16, 25} : std::vector<int>{10, 16};
-        // Full: one capillary time sqrt(ρD³/σ) ≈ 30 ms; one viscous time D²ρ/μ = 16 s would be
-        // 10⁵ steps. Quick: 2 ms.
+        // Full: 10 ms, a third of the capillary time sqrt(ρD³/σ) ≈ 30 ms (one viscous time
+        // D²ρ/μ = 16 s would be 10⁵ steps). Quick: 2 ms.
         const double diameter = 2.0 * DROP_R;
         const double capillary_time = std::sqrt(RHO_L * std::pow(diameter, 3) / SIGMA);
-        const double end = options.full ? capillary_time : 0.002;
+        const double end = options.full ? 0.010 : 0.002;
         const double laplace = 2.0 * SIGMA / DROP_R;
         Json runs = Json::array();
         for (int cpd : resolutions) {
@@ -218,8 +218,8 @@ struct Runner {
               "than 3 cells outside, at the end of the run. Spurious currents: max|u| over the "
               "grid faces, as max|u|·sqrt(ρD/σ). **Run length: "
            << fmt(1e3 * end, "%.3g")
-           << " ms** (" << (options.full ? "one capillary time sqrt(ρD³/σ)" : "quick")
-           << "), not one viscous time D²ρ/μ = 16 s (10⁵ steps at these resolutions).\n\n"
+           << " ms** (capillary time sqrt(ρD³/σ) = " << fmt(1e3 * capillary_time, "%.3g")
+           << " ms), not one viscous time D²ρ/μ = 16 s (10⁵ steps at these resolutions).\n\n"
            << "| cells per D | steps | Δp (Pa) | 2σ/R (Pa) | error | max|u| end (m/s) | "
               "max|u|·sqrt(ρD/σ) end | peak over run | volume drift | max intersecting pairs "
               "|\n|---|---|---|---|---|---|---|---|---|---|\n";
@@ -248,13 +248,14 @@ struct Runner {
 
     // ---- B2 ----
     void b2(std::ostringstream& md) {
+        // Finest first (the one with a target), the table sorted by resolution.
         const std::vector<int> resolutions =
-            options.full ? std::vector<int>{12, 16, 25} : std::vector<int>{12};
+            options.full ? std::vector<int>{25, 16, 12} : std::vector<int>{12};
         const double omega = lamb_omega(2, SIGMA, DROP_R, RHO_L, RHO_G);
         const double period = 2.0 * M_PI / omega;
         const double tau = DROP_R * DROP_R / (1.0 * 5.0 * (MU_L / RHO_L));
-        // Quick: 1.3 periods (the fit needs one full period); full: two periods.
-        const double end = (options.full ? 2.0 : 1.3) * period;
+        // Quick: 1.3 periods (the fit needs one full period); full: 1.5.
+        const double end = (options.full ? 1.5 : 1.3) * period;
         Json runs = Json::array();
         for (int cpd : resolutions) {
             const double box = 4.0 * DROP_R;
@@ -299,6 +300,9 @@ struct Runner {
                 fmt(r.wall_seconds, "%.0f") + " s");
             runs.push_back(run);
         }
+        std::sort(runs.begin(), runs.end(), [](const Json& a, const Json& b) {
+            return a["cells_per_diameter"].get<int>() < b["cells_per_diameter"].get<int>();
+        });
         out.results["B2"] = {{"runs", runs},
                              {"lamb_omega", omega},
                              {"lamb_period", period},
@@ -338,13 +342,13 @@ struct Runner {
         // One wavelength, wall to wall, bulges at both walls and the neck in the middle (free-
         // slip walls are mirror planes); the column crosses the end walls by
         // WALL_OVERLAP_CELLS and is cut there by a box (outside the domain).
-        const int cells = options.full ? 54 : 27;  // R = 6 (full) or 3 (quick) cells
+        const int cells = options.full ? 36 : 27;  // R = 4 (full, as jet_pinch) or 3 cells
         const double dx = JET_WAVELENGTH / cells;
         const double k = 2.0 * M_PI / JET_WAVELENGTH;
         const double rate = rayleigh_plateau_rate(SIGMA, RHO_L, JET_R, k);
         const double capillary_time = std::sqrt(RHO_L * std::pow(JET_R, 3) / SIGMA);
         // Quick: the linear regime only (ε grows ≈ 2.5×); full: on to pinch-off.
-        const double end = options.full ? 0.035 : 0.008;
+        const double end = options.full ? 0.030 : 0.008;
         const double m = WALL_OVERLAP_CELLS * dx;
         Json j = base_scene("B3 Rayleigh–Plateau");
         j["domain"] = {{"min", {0, 0, 0}},
