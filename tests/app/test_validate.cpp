@@ -9,6 +9,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -33,10 +34,27 @@ constexpr double PAPER_A1_L1_COARSE = 0.00114493;
 constexpr double A1_L1_COARSE_BOUND = 2.0 * PAPER_A1_L1_COARSE;
 /// Sphere under mean-curvature flow: vertex distance to the exact R(t), relative to R.
 constexpr double MCF_RELATIVE_VERTEX_ERROR = 5e-3;
+/// A2 dumbbell at ξ = 0.04 against the quick level-set reference (Δx = 0.02): L1 measured
+/// 5.5e-4 (paper 2.6e-4 against its own, finer reference); the quick reference's two grids
+/// (Δx = 0.04, 0.02) differ by 1.4e-3 on average at the mesh points, so neither bound is tight.
+constexpr double A2_QUICK_L1_BOUND = 1.5e-3;
+constexpr double A2_QUICK_REFERENCE_DIFFERENCE_BOUND = 3e-3;
 /// Enright quick variant (period 1, ξ = 0.02): relative volume change bound, percent.
 constexpr double ENRIGHT_QUICK_VOLUME_PERCENT = 0.5;
 /// Enright quick: the surface returns near the initial sphere (L∞ distance, m; ξ = 0.02).
 constexpr double ENRIGHT_QUICK_RETURN_LINF = 0.01;
+
+/// Part B quick variants (coarse: the targets of VALIDATION.md are for the --full resolutions).
+/// Measured: Δp −0.003 % at 10 and 16 cells per diameter; Lamb frequency −5.8 % at 12 cells
+/// per diameter; Rayleigh–Plateau growth rate −6.4 % at R = 3 cells; capillary-wave frequency
+/// −4.3 % at 16 cells per wavelength (the errors shrink with resolution: `validate --full`).
+constexpr double B1_JUMP_RELATIVE = 0.02;           ///< VALIDATION.md B1 (≥ 16 cells per D)
+constexpr double B1_SPURIOUS_CAPILLARY_NUMBER = 0.05;  ///< max|u| sqrt(ρD/σ); measured 6e-3
+constexpr double B2_QUICK_FREQUENCY_RELATIVE = 0.08;
+constexpr double B3_QUICK_RATE_RELATIVE = 0.10;
+constexpr double B4_QUICK_FREQUENCY_RELATIVE = 0.08;
+/// An oscillation fit must describe the run: rms residual below this fraction of the amplitude.
+constexpr double FIT_RMS_FRACTION = 0.05;
 
 class QuickValidation : public ::testing::Test {
 protected:
@@ -125,6 +143,21 @@ TEST_F(QuickValidation, SphereMeanCurvatureFollowsExactRadius) {
     EXPECT_LT(s[0]["error"]["vertex_linf"].get<double>(), MCF_RELATIVE_VERTEX_ERROR * r);
 }
 
+TEST_F(QuickValidation, DumbbellPinchesOffNearTheLevelSetReference) {
+    const std::vector<Json> d = runs("A2", "dumbbell");
+    ASSERT_EQ(d.size(), 1u);
+    EXPECT_TRUE(d[0]["completed"].get<bool>());
+    EXPECT_EQ(d[0]["final_components"].get<int>(), 2);
+    ASSERT_FALSE(d[0]["pinch_off_time"].is_null());
+    EXPECT_TRUE(d[0]["error_within_reference_band"].get<bool>());
+    std::cout << "[ measured ] A2 dumbbell ξ=0.04 vs level-set reference: L∞ "
+              << d[0]["error"]["linf"] << ", L1 " << d[0]["error"]["l1"]
+              << "; reference self-difference mean " << d[0]["reference_difference"]["l1"] << "\n";
+    EXPECT_LT(d[0]["error"]["l1"].get<double>(), A2_QUICK_L1_BOUND);
+    EXPECT_LT(d[0]["reference_difference"]["l1"].get<double>(),
+              A2_QUICK_REFERENCE_DIFFERENCE_BOUND);
+}
+
 TEST_F(QuickValidation, EnrightQuickConservesVolumeAndReturns) {
     const std::vector<Json> s = runs("A3", "Enright");
     ASSERT_EQ(s.size(), 1u);
@@ -143,6 +176,59 @@ TEST_F(QuickValidation, ReportHasEveryCaseTable) {
                               "| run | ξ | t | steps | triangles | volume change %"})
         EXPECT_NE(s_report.find(table), std::string::npos) << table;
     EXPECT_NE(s_report.find("0.00811073"), std::string::npos);  // the paper's numbers beside ours
+}
+
+TEST_F(QuickValidation, PartBStaticDropHasTheLaplaceJump) {
+    const Json& runs = s_results["part_b"]["B1"]["runs"];
+    ASSERT_GE(runs.size(), 2u);
+    for (const Json& r : runs) {
+        SCOPED_TRACE(r["cells_per_diameter"].dump() + " cells per diameter");
+        EXPECT_TRUE(r["completed"].get<bool>());
+        EXPECT_EQ(r["max_intersecting_pairs"].get<int>(), 0);
+        EXPECT_LT(std::abs(r["jump_relative_error"].get<double>()), B1_JUMP_RELATIVE);
+        EXPECT_LT(r["capillary_number_peak"].get<double>(), B1_SPURIOUS_CAPILLARY_NUMBER);
+    }
+}
+
+TEST_F(QuickValidation, PartBOscillationsAndGrowthAgainstTheory) {
+    const Json& b = s_results["part_b"];
+    ASSERT_EQ(b["B2"]["runs"].size(), 1u);
+    const Json& drop = b["B2"]["runs"][0];
+    EXPECT_LT(std::abs(drop["frequency_relative_error"].get<double>()),
+              B2_QUICK_FREQUENCY_RELATIVE);
+    EXPECT_LT(drop["rms_residual"].get<double>(), FIT_RMS_FRACTION * drop["amplitude"].get<double>());
+    ASSERT_EQ(b["B3"]["runs"].size(), 1u);
+    const Json& jet = b["B3"]["runs"][0];
+    EXPECT_GE(jet["fit_samples"].get<int>(), 10);
+    EXPECT_LT(std::abs(jet["rate_relative_error"].get<double>()), B3_QUICK_RATE_RELATIVE);
+    ASSERT_EQ(b["B4"]["runs"].size(), 1u);
+    const Json& wave = b["B4"]["runs"][0];
+    EXPECT_LT(std::abs(wave["frequency_relative_error"].get<double>()),
+              B4_QUICK_FREQUENCY_RELATIVE);
+    EXPECT_LT(wave["rms_residual"].get<double>(), FIT_RMS_FRACTION * wave["amplitude"].get<double>());
+    for (const char* id : {"B2", "B3", "B4"})
+        for (const Json& r : b[id]["runs"]) {
+            SCOPED_TRACE(id);
+            EXPECT_TRUE(r["completed"].get<bool>());
+            EXPECT_EQ(r["max_intersecting_pairs"].get<int>(), 0);
+            EXPECT_LT(r["volume_drift"].get<double>(), 0.005);
+        }
+}
+
+TEST_F(QuickValidation, PartBMergeSceneKeepsPhaseVolumes) {
+    const Json& runs = s_results["part_b"]["B5"]["runs"];
+    ASSERT_FALSE(runs.empty());
+    for (const Json& r : runs) {
+        SCOPED_TRACE(r["scene"].get<std::string>());
+        EXPECT_TRUE(r["topology_ok"].get<bool>());
+        EXPECT_EQ(r["max_intersecting_pairs"].get<int>(), 0);
+        EXPECT_LT(r["volume_drift_inside"].get<double>(), 0.005);
+        EXPECT_LT(r["volume_drift_other"].get<double>(), 0.005);
+    }
+    for (const char* heading : {"## B1", "## B2", "## B3", "## B4", "## B5"})
+        EXPECT_NE(s_report.find(heading), std::string::npos) << heading;
+    EXPECT_NE(s_report.find("| cells per D | steps | fitted period (ms) | Lamb (ms)"),
+              std::string::npos);
 }
 
 }  // namespace
