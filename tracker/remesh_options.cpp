@@ -44,6 +44,8 @@ void RemeshOptions::validate() const {
             "must be in (0, 1)");
     require(open_unit(corner_eigenvalue_ratio), "RemeshOptions::corner_eigenvalue_ratio",
             "must be in (0, 1)");
+    require(std::isfinite(flip_fold_weight) && flip_fold_weight >= 0.0,
+            "RemeshOptions::flip_fold_weight", "must be finite and >= 0");
     require(smoothing_iterations >= 0, "RemeshOptions::smoothing_iterations", "must be >= 0");
     require(std::isfinite(smoothing_step_fraction) && smoothing_step_fraction > 0.0 &&
                 smoothing_step_fraction <= 1.0,

@@ -65,6 +65,24 @@ double edge_parameter(const SurfaceMesh& mesh, const CollapsePlan& plan) {
     return std::clamp((plan.position - mesh.position(plan.kept)).dot(d) / length2, 0.0, 1.0);
 }
 
+/// Largest volume-preserving correction as a fraction of the edge length; a larger one means a
+/// nearly flat-folded star, and the uncorrected position is kept.
+constexpr double MAX_VOLUME_CORRECTION_FRACTION = 0.5;
+
+/// `plan` with its position moved along the volume gradient so that the collapse keeps the
+/// enclosed volume exactly (the volume after the collapse is linear in the new position).
+CollapsePlan volume_preserving(const SurfaceMesh& mesh, CollapsePlan plan) {
+    const Vec3 g = collapse_volume_gradient(mesh, plan);
+    const double g2 = g.squaredNorm();
+    if (!(g2 > 0.0))
+        return plan;
+    const Vec3 correction = -collapse_volume_change(mesh, plan) / g2 * g;
+    const double length = (mesh.position(plan.kept) - mesh.position(plan.removed)).norm();
+    if (correction.norm() <= MAX_VOLUME_CORRECTION_FRACTION * length)
+        plan.position += correction;
+    return plan;
+}
+
 /// Trajectory end points to try, preferred first, then towards the midpoint.
 struct PlanCandidates {
     std::vector<CollapsePlan> plans;
@@ -103,7 +121,11 @@ PlanCandidates plan_collapse(const SurfaceMesh& mesh, int ei, const RemeshOption
         base.kept = keep0 ? e[0] : e[1];
         base.removed = mesh.other_vertex(ei, base.kept);
         base.position = mesh.position(base.kept);
-        out.plans.push_back(base);
+        // A ridge vertex may move across its ridge to keep the volume; a corner stays exactly.
+        const VertexFeature kept_feature = keep0 ? q0.feature : q1.feature;
+        const bool correct =
+            options.collapse_preserves_volume && kept_feature != VertexFeature::corner;
+        out.plans.push_back(correct ? volume_preserving(mesh, base) : base);
         out.feature_kept = true;
         return out;
     }
@@ -121,7 +143,8 @@ PlanCandidates plan_collapse(const SurfaceMesh& mesh, int ei, const RemeshOption
         const double w = n == 1 ? 0.0 : static_cast<double>(k) / (n - 1);
         CollapsePlan plan = base;
         plan.position = (1.0 - w) * preferred + w * midpoint;
-        out.plans.push_back(plan);
+        out.plans.push_back(options.collapse_preserves_volume ? volume_preserving(mesh, plan)
+                                                              : plan);
     }
     return out;
 }
@@ -214,6 +237,25 @@ double collapse_volume_change(const SurfaceMesh& mesh, const CollapsePlan& plan)
         six_change += q0.dot(q1.cross(q2));
     }
     return six_change / 6.0;
+}
+
+Vec3 collapse_volume_gradient(const SurfaceMesh& mesh, const CollapsePlan& plan) {
+    // Every surviving triangle of the star holds exactly one endpoint, so the volume after the
+    // collapse is linear in plan.position: Σ (u − o) × (w − o) / 6 over those triangles (p, u, w).
+    Vec3 six_gradient = Vec3::Zero();
+    const Vec3& origin = plan.position;
+    for (int ti : star_triangles(mesh, plan)) {
+        const Triangle& t = mesh.triangle(ti);
+        if (contains(t, plan.kept) && contains(t, plan.removed))
+            continue;
+        for (int k = 0; k < 3; ++k)
+            if (t[k] == plan.kept || t[k] == plan.removed) {
+                six_gradient += (mesh.position(t[(k + 1) % 3]) - origin)
+                                    .cross(mesh.position(t[(k + 2) % 3]) - origin);
+                break;
+            }
+    }
+    return six_gradient / 6.0;
 }
 
 bool collapse_changes_volume_too_much(const SurfaceMesh& mesh, const CollapsePlan& plan,

@@ -3,7 +3,12 @@
 /// position is the butterfly point, except that a vertex on a ridge or corner (quadric metric
 /// tensor, quadric.h) keeps its place when the other end is less of a feature (of two corners,
 /// the sharper one), and an edge between two ridge vertices collapses to its midpoint (the
-/// butterfly stencil would reach across the feature and round it off). Both endpoints
+/// butterfly stencil would reach across the feature and round it off). With
+/// RemeshOptions::collapse_preserves_volume (default) that position then moves along the
+/// gradient of the enclosed volume (the area-weighted normal of the new star, so a kept ridge
+/// vertex moves across its ridge, not along it; a kept corner does not move) until the
+/// collapse keeps the volume exactly: the coarser star otherwise cuts inside a convex
+/// surface. Both endpoints
 /// move there as a pseudo-motion checked by CCD; if it may collide, positions closer to the
 /// edge midpoint are tried (not when a feature vertex stays put), and if none is safe the
 /// collapse is abandoned. A collapse is also
@@ -62,6 +67,9 @@ bool collapse_inverts_normal(const SurfaceMesh& mesh, const CollapsePlan& plan,
                              double max_normal_change_degrees);
 /// Signed change of the enclosed volume when both endpoints move to plan.position.
 double collapse_volume_change(const SurfaceMesh& mesh, const CollapsePlan& plan);
+/// Gradient of the enclosed volume after the collapse with respect to plan.position (m²): the
+/// volume is linear in that position, so moving it by −ΔV g/|g|² keeps the volume exactly.
+Vec3 collapse_volume_gradient(const SurfaceMesh& mesh, const CollapsePlan& plan);
 /// True when |collapse_volume_change| > γ.
 bool collapse_changes_volume_too_much(const SurfaceMesh& mesh, const CollapsePlan& plan,
                                       double gamma);

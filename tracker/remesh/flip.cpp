@@ -3,6 +3,7 @@
 #include "tracker/intersection.h"
 #include "tracker/remesh/local_safety.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -13,6 +14,9 @@ namespace meniscus::tracker {
 namespace {
 
 constexpr double PI = 3.14159265358979323846;
+/// A quad whose angles opposite the edge exceed π by this much (two angles above 112.5°) is
+/// far enough from Delaunay to flip across any fold (slivers of thin features, §3.6).
+constexpr double ALWAYS_FLIP_EXCESS = PI / 4.0;
 /// A new triangle whose doubled area is below this fraction of its longest edge squared is
 /// treated as degenerate (the same scale-free tolerance validate_mesh uses by default).
 constexpr double DEGENERATE_AREA_FRACTION = 1e-12;
@@ -80,7 +84,16 @@ bool flip_improves(const SurfaceMesh& mesh, const FlipStencil& s, const RemeshOp
     const double new_length = (c - d).norm();
     if (!(new_length < (1.0 - options.min_flip_length_decrease_fraction) * old_length))
         return false;
-    return angle_at(c, a, b) + angle_at(d, a, b) > PI;
+    const double required_excess =
+        std::min(options.flip_fold_weight * flip_fold_angle(mesh, s), ALWAYS_FLIP_EXCESS);
+    return angle_at(c, a, b) + angle_at(d, a, b) > PI + required_excess;
+}
+
+double flip_fold_angle(const SurfaceMesh& mesh, const FlipStencil& s) {
+    const Vec3 &a = mesh.position(s.a), &b = mesh.position(s.b);
+    const Vec3 n0 = normal_of(a, b, mesh.position(s.c));
+    const Vec3 n1 = normal_of(b, a, mesh.position(s.d));
+    return std::atan2(n0.cross(n1).norm(), n0.dot(n1));
 }
 
 bool flip_creates_existing_edge(const SurfaceMesh& mesh, const FlipStencil& s) {

@@ -35,8 +35,12 @@ struct FlipStencil {
     int a = INVALID_INDEX, b = INVALID_INDEX, c = INVALID_INDEX, d = INVALID_INDEX;
 };
 
+/// Fold angle (radians, in [0, π]) between the normals of triangles (a, b, c) and (b, a, d).
+double flip_fold_angle(const SurfaceMesh& mesh, const FlipStencil& s);
 /// True when the stencil's edge should flip: |cd| < (1 − min decrease) |ab| and the angles at
-/// c and d sum to more than π (not locally Delaunay).
+/// c and d sum to more than π + min(options.flip_fold_weight · flip_fold_angle, π/4) (not
+/// locally Delaunay, by more than the fold makes it worth: a flip across a fold changes the
+/// shape; a quad beyond π/4 flips anyway).
 bool flip_improves(const SurfaceMesh& mesh, const FlipStencil& s, const RemeshOptions& options);
 /// True when edge (c, d) already exists (the flip would create a non-manifold edge or a
 /// degenerate tetrahedron) or c = d.

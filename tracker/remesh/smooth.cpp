@@ -14,6 +14,21 @@ constexpr double PSEUDO_STEP_DURATION = 1.0;
 
 }  // namespace
 
+Vec3 vertex_volume_gradient(const SurfaceMesh& mesh, int vi) {
+    Vec3 six_gradient = Vec3::Zero();
+    const Vec3& x = mesh.position(vi);
+    for (int ti : mesh.vertex_triangles(vi)) {
+        const Triangle& t = mesh.triangle(ti);
+        for (int k = 0; k < 3; ++k)
+            if (t[k] == vi) {
+                six_gradient +=
+                    (mesh.position(t[(k + 1) % 3]) - x).cross(mesh.position(t[(k + 2) % 3]) - x);
+                break;
+            }
+    }
+    return six_gradient / 6.0;
+}
+
 std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const RemeshOptions& options,
                                            SmoothReport* counts) {
     const FeatureThresholds thresholds{options.ridge_eigenvalue_ratio,
@@ -47,8 +62,14 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
         if (!(total_area > 0.0))
             continue;
         const Vec3 towards = weighted_centroid / total_area - mesh.position(vi);
-        displacement[static_cast<size_t>(vi)] =
-            options.smoothing_step_fraction * (q.null_space_projector() * towards);
+        Vec3 d = options.smoothing_step_fraction * (q.null_space_projector() * towards);
+        if (options.smoothing_preserves_volume) {
+            const Vec3 g = vertex_volume_gradient(mesh, vi);
+            const double g2 = g.squaredNorm();
+            if (g2 > 0.0)
+                d -= g.dot(d) / g2 * g;
+        }
+        displacement[static_cast<size_t>(vi)] = d;
     }
     return displacement;
 }

@@ -28,8 +28,17 @@ struct SmoothReport {
     double seconds = 0.0;
 };
 
+/// Gradient (m²) of the enclosed volume with respect to vertex vi's position, all other vertices
+/// fixed: Σ (u − x) × (w − x) / 6 over vi's triangles (x, u, w), one third of their summed area
+/// vectors. The volume is linear in one vertex's position, so a displacement orthogonal to it
+/// keeps the volume exactly.
+Vec3 vertex_volume_gradient(const SurfaceMesh& mesh, int vi);
+
 /// The null-space smoothing displacement of every live vertex (zero for dead, boundary and
-/// corner vertices), scaled by options.smoothing_step_fraction.
+/// corner vertices), scaled by options.smoothing_step_fraction; with
+/// options.smoothing_preserves_volume, minus its component along vertex_volume_gradient (so
+/// each vertex moved alone keeps the volume; moving neighbours together changes it at second
+/// order).
 std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const RemeshOptions& options,
                                            SmoothReport* counts = nullptr);
 
