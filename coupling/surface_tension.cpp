@@ -2,6 +2,7 @@
 
 #include "tracker/distance.h"
 #include "tracker/flows/mean_curvature.h"
+#include "tracker/mesh_measures.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -61,6 +62,43 @@ double curvature_at_closest_point(const SurfaceMesh& mesh, const std::vector<dou
            proximity.barycentric[2] * kappa[static_cast<size_t>(t[2])];
 }
 
+/// Subtracts from `velocities` a uniform normal speed per connected component so that each
+/// component's enclosed volume has zero rate of change: dV/dt = Σ_v u_v · G_v with G_v = ⅓ Σ of
+/// the area vectors of v's triangles (∇_v V of a closed mesh).
+void remove_volume_change(const SurfaceMesh& mesh, std::vector<Vec3>& velocities) {
+    const tracker::Components components = tracker::triangle_components(mesh);
+    std::vector<Vec3> gradient(velocities.size(), Vec3::Zero());
+    std::vector<int> vertex_component(velocities.size(), tracker::INVALID_INDEX);
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti))
+            continue;
+        const tracker::Triangle& t = mesh.triangle(ti);
+        const Vec3 area_vector = 0.5 * (mesh.position(t[1]) - mesh.position(t[0]))
+                                           .cross(mesh.position(t[2]) - mesh.position(t[0]));
+        for (int vi : t) {
+            gradient[static_cast<size_t>(vi)] += area_vector / 3.0;
+            vertex_component[static_cast<size_t>(vi)] =
+                components.triangle_component[static_cast<size_t>(ti)];
+        }
+    }
+    std::vector<double> rate(static_cast<size_t>(components.count), 0.0);
+    std::vector<double> weight(static_cast<size_t>(components.count), 0.0);
+    for (size_t v = 0; v < velocities.size(); ++v) {
+        if (vertex_component[v] == tracker::INVALID_INDEX)
+            continue;
+        rate[static_cast<size_t>(vertex_component[v])] += velocities[v].dot(gradient[v]);
+        weight[static_cast<size_t>(vertex_component[v])] += gradient[v].norm();
+    }
+    for (size_t v = 0; v < velocities.size(); ++v) {
+        const int c = vertex_component[v];
+        const double norm = gradient[v].norm();
+        if (c == tracker::INVALID_INDEX || norm == 0.0 || weight[static_cast<size_t>(c)] == 0.0)
+            continue;
+        velocities[v] -=
+            (rate[static_cast<size_t>(c)] / weight[static_cast<size_t>(c)]) * gradient[v] / norm;
+    }
+}
+
 /// Per-face tallies of one velocity component's faces, reduced after the parallel loop.
 struct AxisTally {
     long long crossed = 0;
@@ -102,6 +140,7 @@ std::vector<tracker::Vec3> subgrid_tension_velocities(const tracker::SurfaceMesh
         for (size_t v = 0; v < component.size(); ++v)
             velocities[v][axis] = -diffusivity * (component[v] - resolved[v]);
     }
+    remove_volume_change(mesh, velocities);
     return velocities;
 }
 

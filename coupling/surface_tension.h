@@ -75,11 +75,12 @@ std::vector<double> smooth_vertex_values(const tracker::SurfaceMesh& mesh,
 /// isolated and boundary vertices): −D (K − S(K)), with K the cotangent curvature normal
 /// (tracker::mean_curvature_normals(), κ n, n outward) and S `resolved_passes` lazy smoothing
 /// passes applied to each of its components. S keeps what the grid resolves (on a sphere mesh with
-/// 10 edges per radius |K − S(K)| ≤ 6 % of |K|, a slight uniform shrinking the volume correction
-/// absorbs), so this is mean-curvature flow restricted to mesh-scale
+/// 10 edges per radius |K − S(K)| ≤ 6 % of |K|), so this is mean-curvature flow restricted to
+/// mesh-scale
 /// patterns: a wrinkle the grid cannot see flattens instead of being carried (and, where the
 /// surface contracts, sharpened) by the interpolated grid velocity, which has no restoring
-/// component at that scale. Volume-neutral to first order (the high-pass has no mean).
+/// component at that scale. Volume-neutral: a uniform normal speed per connected component is
+/// subtracted so that each component's enclosed volume has zero rate of change.
 /// Explicit motion: stable for D Δt ≤ 0.2 h². Throws std::invalid_argument if diffusivity < 0
 /// or resolved_passes < 1.
 std::vector<tracker::Vec3> subgrid_tension_velocities(const tracker::SurfaceMesh& mesh,

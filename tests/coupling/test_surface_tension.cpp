@@ -285,7 +285,7 @@ TEST(SurfaceTension, SubgridTensionFlattensMeshScaleWrinklesAndSparesTheSphere) 
         "change %.2e\n",
         error0 / edge, error1 / edge, steps, tracker::enclosed_volume(wrinkled) / volume0 - 1.0);
     EXPECT_LT(error1, 0.2 * error0);
-    EXPECT_NEAR(tracker::enclosed_volume(wrinkled), volume0, 2e-3 * volume0);
+    EXPECT_NEAR(tracker::enclosed_volume(wrinkled), volume0, 1e-4 * volume0);
     EXPECT_THROW(subgrid_tension_velocities(sphere, -1.0, passes), std::invalid_argument);
     EXPECT_THROW(subgrid_tension_velocities(sphere, 1.0, 0), std::invalid_argument);
 }
