@@ -356,8 +356,15 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
         ++n;
     }
     m_cell = n > 0 && sum > 0.0 ? LOOSE_CELL_FACTOR * sum / n : 1.0;
-    std::vector<std::pair<std::int64_t, int>> keyed;
-    keyed.reserve(static_cast<size_t>(n));
+    // Counting build in O(n): cells are numbered in order of first appearance, then ids are
+    // placed cell by cell in increasing order (no sort).
+    size_t slots = 16;
+    while (slots < 2 * static_cast<size_t>(n))
+        slots *= 2;
+    const size_t mask = slots - 1;
+    m_slot_key.assign(slots, -1);
+    std::vector<int> slot_cell(slots, -1);
+    std::vector<int> cell_of(boxes.size(), -1);
     const double limit = (1 << 20) - 2;
     for (size_t i = 0; i < boxes.size(); ++i) {
         const Box3d& b = boxes[i];
@@ -369,37 +376,41 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
             m_oversized.push_back(static_cast<int>(i));
             continue;
         }
-        keyed.emplace_back(cell_key(lo.cast<int>()), static_cast<int>(i));
-    }
-    std::sort(keyed.begin(), keyed.end());
-    size_t unique = 0;
-    for (size_t i = 0; i < keyed.size(); ++i)
-        if (i == 0 || keyed[i].first != keyed[i - 1].first)
-            ++unique;
-    size_t slots = 16;
-    while (slots < 2 * unique)
-        slots *= 2;
-    m_slot_key.assign(slots, -1);
-    m_slot_range.assign(slots, {0, 0});
-    m_ids.resize(keyed.size());
-    m_cell_boxes.resize(keyed.size());
-    for (size_t i = 0; i < keyed.size();) {
-        size_t j = i;
-        while (j < keyed.size() && keyed[j].first == keyed[i].first) {
-            m_ids[j] = keyed[j].second;
-            m_cell_boxes[j] = boxes[static_cast<size_t>(keyed[j].second)];
-            ++j;
+        const Eigen::Array3i coords = lo.cast<int>();
+        const std::int64_t key = cell_key(coords);
+        size_t slot = mix(key) & mask;
+        while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
+            slot = (slot + 1) & mask;
+        if (m_slot_key[slot] == -1) {
+            m_slot_key[slot] = key;
+            slot_cell[slot] = static_cast<int>(m_cells.size());
+            m_cells.push_back({coords, 0, 0});
         }
-        size_t slot = mix(keyed[i].first) & (slots - 1);
-        while (m_slot_key[slot] != -1)
-            slot = (slot + 1) & (slots - 1);
-        m_slot_key[slot] = keyed[i].first;
-        m_slot_range[slot] = {static_cast<int>(i), static_cast<int>(j)};
-        const Eigen::Array3d lo =
-            (boxes[static_cast<size_t>(keyed[i].second)].min().array() / m_cell).floor();
-        m_cells.push_back({lo.cast<int>(), static_cast<int>(i), static_cast<int>(j)});
-        i = j;
+        const int c = slot_cell[slot];
+        cell_of[i] = c;
+        ++m_cells[static_cast<size_t>(c)].end;  // count for now
     }
+    int offset = 0;
+    for (Cell& cell : m_cells) {
+        cell.begin = offset;
+        offset += cell.end;
+        cell.end = cell.begin;  // fill cursor
+    }
+    m_ids.resize(static_cast<size_t>(offset));
+    m_cell_boxes.resize(static_cast<size_t>(offset));
+    for (size_t i = 0; i < boxes.size(); ++i) {
+        if (cell_of[i] < 0)
+            continue;
+        const auto pos = static_cast<size_t>(m_cells[static_cast<size_t>(cell_of[i])].end++);
+        m_ids[pos] = static_cast<int>(i);
+        m_cell_boxes[pos] = boxes[i];
+    }
+    m_slot_range.assign(slots, {0, 0});
+    for (size_t slot = 0; slot < slots; ++slot)
+        if (slot_cell[slot] >= 0) {
+            const Cell& cell = m_cells[static_cast<size_t>(slot_cell[slot])];
+            m_slot_range[slot] = {cell.begin, cell.end};
+        }
 }
 
 std::pair<int, int> LooseGrid::find_cell(std::int64_t key) const {

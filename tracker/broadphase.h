@@ -104,7 +104,7 @@ struct TrianglePair {
 /// its box's minimum corner), stored contiguously (CSR) and found through a flat hash of cell
 /// keys; elements larger than a cell go to a list checked by every query. A query box looks at
 /// the cells its box reaches extended by one cell towards −∞, which covers every element whose
-/// box can overlap it. Built in O(n log n) by one sort; queries are read-only and thread-safe.
+/// box can overlap it. Built in O(n) by counting; queries are read-only and thread-safe.
 class LooseGrid {
 public:
     /// Builds over `boxes` (empty boxes are skipped); ids are the indices into `boxes`.
@@ -139,7 +139,7 @@ private:
     std::vector<Box3d> m_cell_boxes;                // their boxes, same order (sequential reads)
     std::vector<std::int64_t> m_slot_key;           // flat hash: key per slot (−1 = empty)
     std::vector<std::pair<int, int>> m_slot_range;  // [begin, end) into m_ids per slot
-    std::vector<Cell> m_cells;                      // occupied cells in key order
+    std::vector<Cell> m_cells;                      // occupied cells, first-appearance order
     std::vector<int> m_oversized;
 };
 

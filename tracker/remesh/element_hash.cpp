@@ -1,5 +1,7 @@
 #include "tracker/remesh/element_hash.h"
 
+#include <tbb/parallel_invoke.h>
+
 namespace meniscus::tracker {
 
 Box3d triangle_box(const SurfaceMesh& mesh, int ti) {
@@ -19,15 +21,24 @@ Box3d edge_box(const SurfaceMesh& mesh, int ei) {
 
 ElementHash::ElementHash(const SurfaceMesh& mesh, double cell_size)
     : m_vertices(cell_size), m_edges(cell_size), m_triangles(cell_size) {
-    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
-        if (mesh.vertex_alive(vi))
-            m_vertices.insert(vi, Box3d(mesh.position(vi)));
-    for (int ei = 0; ei < mesh.num_edges(); ++ei)
-        if (mesh.edge_alive(ei))
-            m_edges.insert(ei, edge_box(mesh, ei));
-    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
-        if (mesh.triangle_alive(ti))
-            m_triangles.insert(ti, triangle_box(mesh, ti));
+    // Three independent hashes, each filled in index order by one task: the same content
+    // whatever the threading.
+    tbb::parallel_invoke(
+        [&] {
+            for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+                if (mesh.vertex_alive(vi))
+                    m_vertices.insert(vi, Box3d(mesh.position(vi)));
+        },
+        [&] {
+            for (int ei = 0; ei < mesh.num_edges(); ++ei)
+                if (mesh.edge_alive(ei))
+                    m_edges.insert(ei, edge_box(mesh, ei));
+        },
+        [&] {
+            for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+                if (mesh.triangle_alive(ti))
+                    m_triangles.insert(ti, triangle_box(mesh, ti));
+        });
 }
 
 void ElementHash::begin_update(const SurfaceMesh& mesh, const std::vector<int>& vertices) {
