@@ -857,8 +857,43 @@ TEST(FlowRunner, FaceOffsettingSphereFollowsExactRadiusBothWays) {
                       << ", L∞ " << e.linf << ", L1 " << e.l1 << "\n";
             EXPECT_LT(e.vertex_linf, 0.02 * speed * t_end);
         }
-        EXPECT_GT(observed_order(errors[0], errors[1], mean_edges[0], mean_edges[1]), 1.5);
+        // Second order, or exact to 1e-4 of the distance travelled (the mean-normal move of
+        // smooth vertices is exact on a sphere up to the tilt of irregular fans).
+        const double order = observed_order(errors[0], errors[1], mean_edges[0], mean_edges[1]);
+        EXPECT_TRUE(order > 1.5 || errors[0] < 1e-4 * speed * t_end) << "order " << order;
     }
+}
+
+TEST(FlowRunner, ShrinkingSphereVerticesDoNotDriftInsideTheExactSphere) {
+    // Issue #5: on a shrinking sphere the planes' intersection moves each vertex by h / cos θ
+    // (θ the spread of its face normals) instead of h; the excess accumulates step after step
+    // into a uniform inward bias (A1: 1.1e-3 at ξ = 0.04 after 1 s of shrinking). Smooth
+    // vertices take the mean offset along the mean normal instead.
+    const Vec3 center(0.25, 0.0, 0.0);
+    const double r0 = 0.4, speed = -0.2, t_end = 1.0;
+    double mean_error[2] = {0.0, 0.0};
+    for (int rule = 0; rule < 2; ++rule) {
+        SurfaceMesh mesh = meshed_sphere(center, r0, 0.04);
+        project_to_sphere(mesh, center, r0);
+        FaceOffsettingOptions options;
+        if (rule == 0)
+            options.smooth_dihedral_degrees = 0.0;  // planes' intersection wherever convex
+        const FaceOffsettingStepper stepper([&](double) { return speed; }, options);
+        const FlowRunReport report = run_flow(mesh, stepper, 0.0, t_end);
+        EXPECT_EQ(report.stop, FlowRunStop::reached_end);
+        const double exact = r0 + speed * t_end;
+        int live = 0;
+        for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+            if (mesh.vertex_alive(vi)) {
+                mean_error[rule] += (mesh.position(vi) - center).norm() - exact;
+                ++live;
+            }
+        mean_error[rule] /= live;
+    }
+    std::cout << "[ measured ] sphere 0.4 → 0.2, ξ = 0.04: mean signed vertex error, planes "
+              << mean_error[0] << ", smooth rule " << mean_error[1] << "\n";
+    EXPECT_LT(mean_error[0], -2e-4);
+    EXPECT_LT(std::abs(mean_error[1]), 0.25 * std::abs(mean_error[0]));
 }
 
 TEST(FlowRunner, NeckFaceOffsettingConvergesWhereVertexNormalsDoNot) {
@@ -933,7 +968,12 @@ TEST(FlowRunner, ShrinkingNeckNeedsTheHuygensRuleToConverge) {
     const double planes_order = observed_order(planes_errors[0], planes_errors[2], xis[0], xis[2]);
     std::cout << "[ measured ] observed order: Huygens rule " << huygens_order << ", plane rule "
               << planes_order << "\n";
-    EXPECT_GT(huygens_order, 1.5);
+    // Second order, or exact to rounding of the mesh's own tilt: since smooth vertices take the
+    // mean-normal move (issue #5) the ball parts no longer carry the plane rule's O(ξ²) excess.
+    const double travelled = flow.speed * t_end;
+    const bool all_within =
+        *std::max_element(huygens_errors.begin(), huygens_errors.end()) < 1e-3 * travelled;
+    EXPECT_TRUE(huygens_order > 1.5 || all_within) << "order " << huygens_order;
     EXPECT_LT(huygens_errors.back(), 0.02 * planes_errors.back());
     EXPECT_GT(planes_errors.back(), 0.9 * planes_errors.front());  // no convergence
 }

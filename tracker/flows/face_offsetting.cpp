@@ -104,6 +104,9 @@ void FaceOffsettingOptions::validate() const {
     if (!(max_offset_ratio >= 1.0) || !std::isfinite(max_offset_ratio))
         throw std::invalid_argument("max_offset_ratio: expected a finite number >= 1, got " +
                                     std::to_string(max_offset_ratio));
+    if (!(smooth_dihedral_degrees >= 0.0 && smooth_dihedral_degrees < 180.0))
+        throw std::invalid_argument("smooth_dihedral_degrees: expected a number in [0, 180), got " +
+                                    std::to_string(smooth_dihedral_degrees));
     if (!(null_space_smoothing >= 0.0 && null_space_smoothing <= 1.0))
         throw std::invalid_argument("null_space_smoothing: expected a number in [0, 1], got " +
                                     std::to_string(null_space_smoothing));
@@ -177,6 +180,7 @@ FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
     result.primary_rank.assign(nv, 0);
     result.expanding.assign(nv, 0);
     result.capped.assign(nv, 0);
+    const double smooth_dihedral = options.smooth_dihedral_degrees * M_PI / 180.0;
     // Signed dihedral angle of each vertex's sharpest incident edge (convex > 0).
     const std::vector<double> dominant_dihedral = dominant_dihedral_angles(mesh);
     for (size_t vi = 0; vi < nv; ++vi) {
@@ -205,9 +209,12 @@ FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
             const Vec3 m = normal_sum[vi] / normal_length;
             const double mean_offset = offset_sum[vi] / weight_sum[vi];
             const double dihedral = dominant_dihedral[vi];
-            if (std::abs(dihedral) > FLAT_DIHEDRAL && mean_offset * dihedral > 0.0) {
+            const bool smooth = std::abs(dihedral) < smooth_dihedral;
+            const bool expansion =
+                std::abs(dihedral) > FLAT_DIHEDRAL && mean_offset * dihedral > 0.0;
+            if (smooth || expansion) {
                 d = mean_offset * m;
-                result.expanding[vi] = 1;
+                result.expanding[vi] = expansion ? 1 : 0;
             }
         }
         const double cap = options.max_offset_ratio * max_offset[vi];
