@@ -98,6 +98,8 @@ void visit_fields(V& v, CouplingOptions& o) {
               "restore each connected component's volume every step (followed through merges)");
     v.integer("curvature_smoothing", o.simulation.surface_tension.smoothing_passes,
               Range::between(0, 20), "", "one-ring averaging passes over vertex curvature");
+    v.number("subgrid_rate", o.simulation.surface_tension.subgrid_rate, Range::between(0.0, 0.2),
+             "", "damping rate β of mesh-scale wrinkles the grid cannot resolve (0 = off)");
     enum_field(v, "velocity_interpolation", o.simulation.interpolate.method,
                {{"trilinear", coupling::VelocityInterpolation::trilinear},
                 {"quadratic_bspline", coupling::VelocityInterpolation::quadratic_bspline}},

@@ -418,7 +418,9 @@ struct Runner {
         run["series"]["amplitude"] = amplitude;
         run["series"]["mean_radius"] = mean_radius;
         log("B3 " + std::to_string(cells) + " cells/λ: growth " + fmt(fit.rate) + " 1/s (theory " +
-            fmt(rate) + "), pinch at " + fmt(1e3 * pinch_time) + " ms, " +
+            fmt(rate) + "), " +
+            (pinch_time >= 0.0 ? "pinch at " + fmt(1e3 * pinch_time) + " ms" : "no pinch-off") +
+            ", " +
             fmt(r.wall_seconds, "%.0f") + " s");
         out.results["B3"] = {{"runs", Json::array({run})},
                              {"theory_rate", rate},

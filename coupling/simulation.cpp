@@ -143,8 +143,21 @@ void Simulation::add_subgrid_tension(std::vector<tracker::Vec3>& velocities, dou
                                 : 0.5 * phases.rho_liquid;
     const double t_h = std::sqrt(rho_mean * h * h * h / (2.0 * M_PI * phases.sigma));
     const double diffusivity = options.subgrid_rate * h * h / t_h;
+    // Only vertices inside the fluid box (see subgrid_tension_velocities()).
+    const fluid::MacGrid& grid = m_fluid.grid();
+    const tracker::Vec3 lo = grid.origin();
+    const tracker::Vec3 hi =
+        lo + grid.dx() * tracker::Vec3(grid.nx(), grid.ny(), grid.nz());
+    std::vector<char> inside(static_cast<size_t>(mesh.num_vertices()), 0);
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        if (!mesh.vertex_alive(vi))
+            continue;
+        const tracker::Vec3& x = mesh.position(vi);
+        inside[static_cast<size_t>(vi)] =
+            (x.array() >= lo.array()).all() && (x.array() <= hi.array()).all() ? 1 : 0;
+    }
     const std::vector<tracker::Vec3> subgrid =
-        subgrid_tension_velocities(mesh, diffusivity, options.subgrid_resolved_passes);
+        subgrid_tension_velocities(mesh, diffusivity, options.subgrid_resolved_passes, inside);
     const double max_speed = MAX_SUBGRID_STEP_EDGES * h / dt;
     for (size_t v = 0; v < velocities.size(); ++v) {
         const double speed = subgrid[v].norm();

@@ -65,7 +65,9 @@ double curvature_at_closest_point(const SurfaceMesh& mesh, const std::vector<dou
 /// Subtracts from `velocities` a uniform normal speed per connected component so that each
 /// component's enclosed volume has zero rate of change: dV/dt = Σ_v u_v · G_v with G_v = ⅓ Σ of
 /// the area vectors of v's triangles (∇_v V of a closed mesh).
-void remove_volume_change(const SurfaceMesh& mesh, std::vector<Vec3>& velocities) {
+void remove_volume_change(const SurfaceMesh& mesh, std::vector<Vec3>& velocities,
+                          const std::vector<char>& active) {
+    const auto is_active = [&](size_t v) { return active.empty() || active[v] != 0; };
     const tracker::Components components = tracker::triangle_components(mesh);
     std::vector<Vec3> gradient(velocities.size(), Vec3::Zero());
     std::vector<int> vertex_component(velocities.size(), tracker::INVALID_INDEX);
@@ -84,7 +86,7 @@ void remove_volume_change(const SurfaceMesh& mesh, std::vector<Vec3>& velocities
     std::vector<double> rate(static_cast<size_t>(components.count), 0.0);
     std::vector<double> weight(static_cast<size_t>(components.count), 0.0);
     for (size_t v = 0; v < velocities.size(); ++v) {
-        if (vertex_component[v] == tracker::INVALID_INDEX)
+        if (vertex_component[v] == tracker::INVALID_INDEX || !is_active(v))
             continue;
         rate[static_cast<size_t>(vertex_component[v])] += velocities[v].dot(gradient[v]);
         weight[static_cast<size_t>(vertex_component[v])] += gradient[v].norm();
@@ -92,7 +94,8 @@ void remove_volume_change(const SurfaceMesh& mesh, std::vector<Vec3>& velocities
     for (size_t v = 0; v < velocities.size(); ++v) {
         const int c = vertex_component[v];
         const double norm = gradient[v].norm();
-        if (c == tracker::INVALID_INDEX || norm == 0.0 || weight[static_cast<size_t>(c)] == 0.0)
+        if (c == tracker::INVALID_INDEX || !is_active(v) || norm == 0.0 ||
+            weight[static_cast<size_t>(c)] == 0.0)
             continue;
         velocities[v] -=
             (rate[static_cast<size_t>(c)] / weight[static_cast<size_t>(c)]) * gradient[v] / norm;
@@ -123,11 +126,15 @@ void SurfaceTensionOptions::validate() const {
 }
 
 std::vector<tracker::Vec3> subgrid_tension_velocities(const tracker::SurfaceMesh& mesh,
-                                                      double diffusivity, int resolved_passes) {
+                                                      double diffusivity, int resolved_passes,
+                                                      const std::vector<char>& active) {
     if (!(diffusivity >= 0.0))
         throw std::invalid_argument("subgrid_tension_velocities: diffusivity must be >= 0");
     if (resolved_passes < 1)
         throw std::invalid_argument("subgrid_tension_velocities: resolved_passes must be >= 1");
+    if (!active.empty() && active.size() != static_cast<size_t>(mesh.num_vertices()))
+        throw std::invalid_argument(
+            "subgrid_tension_velocities: active must be empty or sized num_vertices()");
     const std::vector<Vec3> curvature_normal = tracker::mean_curvature_normals(mesh);
     std::vector<Vec3> velocities(curvature_normal.size(), Vec3::Zero());
     if (diffusivity == 0.0)
@@ -138,9 +145,10 @@ std::vector<tracker::Vec3> subgrid_tension_velocities(const tracker::SurfaceMesh
             component[v] = curvature_normal[v][axis];
         const std::vector<double> resolved = smooth_vertex_values(mesh, component, resolved_passes);
         for (size_t v = 0; v < component.size(); ++v)
-            velocities[v][axis] = -diffusivity * (component[v] - resolved[v]);
+            velocities[v][axis] =
+                active.empty() || active[v] ? -diffusivity * (component[v] - resolved[v]) : 0.0;
     }
-    remove_volume_change(mesh, velocities);
+    remove_volume_change(mesh, velocities, active);
     return velocities;
 }
 

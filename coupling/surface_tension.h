@@ -81,10 +81,17 @@ std::vector<double> smooth_vertex_values(const tracker::SurfaceMesh& mesh,
 /// surface contracts, sharpened) by the interpolated grid velocity, which has no restoring
 /// component at that scale. Volume-neutral: a uniform normal speed per connected component is
 /// subtracted so that each component's enclosed volume has zero rate of change.
-/// Explicit motion: stable for D Δt ≤ 0.2 h². Throws std::invalid_argument if diffusivity < 0
-/// or resolved_passes < 1.
+/// Explicit motion: stable for D Δt ≤ 0.2 h².
+/// `active` (empty = every vertex, else one flag per vertex): only flagged vertices move, and
+/// the volume-neutral speed is spread over them alone. The coupled step flags the vertices
+/// inside the fluid domain: parts of a surface that reach past the walls (the cut edges of the
+/// capillary-wave slab, the ends of a wall-crossing jet) are not physical interface, and
+/// damping their creases would shift the whole component through the volume-neutral term.
+/// Throws std::invalid_argument if diffusivity < 0, resolved_passes < 1 or active has the wrong
+/// size.
 std::vector<tracker::Vec3> subgrid_tension_velocities(const tracker::SurfaceMesh& mesh,
-                                                      double diffusivity, int resolved_passes);
+                                                      double diffusivity, int resolved_passes,
+                                                      const std::vector<char>& active = {});
 
 /// Signed mean curvature κ (1/m, sum of principal curvatures) per vertex in the fluid's sign
 /// convention (see the file comment), smoothed by `smoothing_passes` passes of
