@@ -139,20 +139,38 @@ double VolumeTracker::add_correction(std::vector<Vec3>& velocities, double dt) c
         for (int v : t)
             normal[static_cast<size_t>(v)] += n2;  // area-weighted
     }
-    double largest = 0.0;
+    // Per component: the first-order volume rate of the given velocities, Σ_v u_v·∇V_v with
+    // ∇V_v = Σ (area vectors of v's triangles)/3 = normal_v/6, and the rate per unit normal
+    // speed, Σ_v |∇V_v|.
+    std::vector<int> vertex_component(static_cast<size_t>(m_mesh.num_vertices()), -1);
+    std::vector<double> rate(nc, 0.0), rate_per_speed(nc, 0.0);
     for (int vi = 0; vi < m_mesh.num_vertices(); ++vi) {
         if (!m_mesh.vertex_alive(vi) || m_mesh.vertex_triangles(vi).empty())
             continue;
+        const size_t v = static_cast<size_t>(vi);
         const int comp =
             c.triangle_component[static_cast<size_t>(m_mesh.vertex_triangles(vi).front())];
-        const double a = area[static_cast<size_t>(comp)];
-        const double n = normal[static_cast<size_t>(vi)].norm();
-        if (!(a > 0.0) || !(n > 0.0))
+        vertex_component[v] = comp;
+        rate[static_cast<size_t>(comp)] += velocities[v].dot(normal[v]) / 6.0;
+        rate_per_speed[static_cast<size_t>(comp)] += normal[v].norm() / 6.0;
+    }
+    double largest = 0.0;
+    for (int vi = 0; vi < m_mesh.num_vertices(); ++vi) {
+        const size_t v = static_cast<size_t>(vi);
+        const int comp = vertex_component[v];
+        if (comp < 0)
             continue;
-        const double offset =
-            (m_targets[static_cast<size_t>(comp)] - volume[static_cast<size_t>(comp)]) / a;
-        velocities[static_cast<size_t>(vi)] += (offset / dt) * normal[static_cast<size_t>(vi)] / n;
-        largest = std::max(largest, std::abs(offset));
+        const size_t ci = static_cast<size_t>(comp);
+        const double n = normal[v].norm();
+        if (!(area[ci] > 0.0) || !(n > 0.0) || !(rate_per_speed[ci] > 0.0))
+            continue;
+        // Normal speed that makes the component's volume reach its target at the end of the
+        // step to first order: it removes the rate the motion would add (interpolation error;
+        // parts of a surface outside the domain, which move with the clamped wall velocity)
+        // and closes the remaining gap V* − V.
+        const double speed = ((m_targets[ci] - volume[ci]) / dt - rate[ci]) / rate_per_speed[ci];
+        velocities[v] += speed * normal[v] / n;
+        largest = std::max(largest, std::abs(speed) * dt);
     }
     return largest;
 }

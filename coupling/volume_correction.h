@@ -9,9 +9,14 @@
 /// (a pinch-off) share their target in proportion to the new components' current volumes. A
 /// component with no surviving vertex of any old one keeps its current volume as target.
 ///
-/// Correction: component c with volume V, target V*, area A moves every vertex along its
-/// area-weighted normal by (V* − V)/A — added to the vertices' velocities as (V* − V)/(A Δt),
-/// so it goes through the tracker's collision-safe integration like any motion.
+/// Correction: component c with volume V and target V* gets a uniform normal speed w_c added to
+/// the velocities u of its vertices, chosen so that the volume at the end of the step is V* to
+/// first order: dt·(Σ_v u_v·∇V_v + w_c Σ_v |∇V_v|) = V* − V, with ∇V_v the volume gradient
+/// of vertex v (a third of its triangles' area vectors). So the correction both restores the
+/// target and removes the volume rate of the motion itself (the interpolation error of the
+/// grid velocity; parts of a surface outside the domain, which move with the clamped wall
+/// velocity and would otherwise add the rate of a whole step every step). It goes through the
+/// tracker's collision-safe integration like any motion.
 
 #include "tracker/mesh.h"
 
@@ -43,8 +48,9 @@ public:
     /// Call after the mesh changes of the step (topology, compaction) and before computing the
     /// correction: matches components and updates targets.
     VolumeReport match_components();
-    /// Adds the correction velocity (see file comment) to `velocities` (sized num_vertices()).
-    /// `dt` > 0 (s). Returns the largest correction displacement applied (m).
+    /// Adds the correction velocity (see file comment) to `velocities` (sized num_vertices()),
+    /// which must already hold the step's motion. `dt` > 0 (s). Returns the largest correction
+    /// displacement applied (m).
     double add_correction(std::vector<tracker::Vec3>& velocities, double dt) const;
 
     /// Targets of the current components (after match_components()).
