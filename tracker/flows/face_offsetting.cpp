@@ -209,7 +209,10 @@ FaceOffset face_offset_displacements(const SurfaceMesh& mesh,
             const Vec3 m = normal_sum[vi] / normal_length;
             const double mean_offset = offset_sum[vi] / weight_sum[vi];
             const double dihedral = dominant_dihedral[vi];
-            const bool smooth = std::abs(dihedral) < smooth_dihedral;
+            // Convex or flat only: on a concave patch moving outward (the neck after a merge)
+            // characteristics do cross, and the mean-normal move there compresses triangles
+            // until the inversion limit cuts the step (A1 at ξ = 0.02: 1137 steps instead of 445).
+            const bool smooth = dihedral >= 0.0 && dihedral < smooth_dihedral;
             const bool expansion =
                 std::abs(dihedral) > FLAT_DIHEDRAL && mean_offset * dihedral > 0.0;
             if (smooth || expansion) {

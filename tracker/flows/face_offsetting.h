@@ -26,8 +26,8 @@
 /// when that edge is convex and the motion outward (h̄ > 0), or concave and inward. Deciding by the
 /// sharpest edge rather than by the mean curvature keeps a concave crease on a saddle (the neck
 /// right after two spheres merge, convex around the neck) a shock. On smooth patches both rules
-/// agree to O(h θ²), and the mean-normal move is exact for a sphere: vertices whose sharpest
-/// edge bends less than `smooth_dihedral_degrees` always take it.
+/// agree to O(h θ²), and the mean-normal move is exact for a sphere: convex vertices whose
+/// sharpest edge bends less than `smooth_dihedral_degrees` always take it.
 ///
 /// Weights wᵢ: triangle areas (default) or the triangle's interior angle at the vertex.
 ///
@@ -70,12 +70,13 @@ struct FaceOffsettingOptions {
     /// and low-valence vertices with scattered normals, where the least-squares intersection
     /// would otherwise throw the vertex many offsets away.
     double max_offset_ratio = 4.0;
-    /// Vertices whose sharpest incident edge bends by less than this (degrees, in [0, 180))
-    /// lie on a smooth patch and move by the mean offset along the mean normal whatever the
-    /// direction: there characteristics do not cross within a step, and the plane intersection
-    /// would overshoot a shrinking sphere by h (1/cos θ − 1) per step (θ the spread of the face
-    /// normals), a bias that accumulates (A1 at ξ = 0.04: vertices 1.1e-3 inside the exact
-    /// spheres at t = 2 with 0, 5e-4 with 20). Sharper creases follow the entropy rule above.
+    /// Convex or flat vertices whose sharpest incident edge bends by less than this (degrees,
+    /// in [0, 180)) lie on a smooth patch and move by the mean offset along the mean normal
+    /// whatever the direction: there characteristics do not cross within a step, and the plane
+    /// intersection would overshoot a shrinking sphere by h (1/cos θ − 1) per step (θ the
+    /// spread of the face normals), a bias that accumulates (A1 at ξ = 0.04: vertices 1.1e-3
+    /// inside the exact spheres at t = 2 with 0, 5e-4 with 20). Sharper creases and concave
+    /// vertices follow the entropy rule above.
     double smooth_dihedral_degrees = 20.0;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
