@@ -79,19 +79,6 @@ ModeFit fit_mode(const std::vector<double>& s, const std::vector<double>& h, dou
 
 // ---- Running ----------------------------------------------------------------------------------
 
-coupling::Simulation make_fluid_simulation(const Scene& scene) {
-    tracker::SurfaceMesh initial = build_initial_surface(scene);
-    const double dx = scene.domain.size.x() / scene.domain.cells;
-    const auto cells_along = [&](double size) {
-        return std::max(1, static_cast<int>(std::lround(size / dx)));
-    };
-    fluid::FluidSolver solver(scene.domain.cells, cells_along(scene.domain.size.y()),
-                              cells_along(scene.domain.size.z()), dx, scene.domain.min,
-                              scene.fluid);
-    return coupling::Simulation(tracker::SurfaceTracker(std::move(initial), scene.tracker),
-                                std::move(solver), scene.coupling.simulation);
-}
-
 FluidRunRecord run_sampled(coupling::Simulation& sim, double end_time,
                            const std::function<void(const coupling::Simulation&)>& sample,
                            long long max_steps) {

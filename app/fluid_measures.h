@@ -17,11 +17,6 @@ namespace meniscus::app {
 
 // ---- Running a fluid scene step by step ------------------------------------------------------
 
-/// The coupled simulation of a fluid scene set up as `meniscus run` sets it up (grid from
-/// /domain, initial surface from /surface with the /surface/inside labels). /initial_velocity
-/// is not applied: the fluid starts at rest. Throws what build_initial_surface() throws.
-coupling::Simulation make_fluid_simulation(const Scene& scene);
-
 /// What a sampled run recorded after every step (index 0: the initial state).
 struct FluidRunRecord {
     std::vector<double> t;                ///< s

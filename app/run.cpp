@@ -416,10 +416,8 @@ nlohmann::json fluid_frame_stats(int frame, double time, long long steps,
     return line;
 }
 
-RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
-                          const std::atomic<bool>& stop) {
-    std::string report;
-    SurfaceMesh initial = build_initial_surface(scene, &report);
+coupling::Simulation make_fluid_simulation(const Scene& scene, std::string* report) {
+    SurfaceMesh initial = build_initial_surface(scene, report);
     const double dx = scene.domain.size.x() / scene.domain.cells;
     const auto cells_along = [&](double size) {
         return std::max(1, static_cast<int>(std::lround(size / dx)));
@@ -428,8 +426,15 @@ RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
                               cells_along(scene.domain.size.z()), dx, scene.domain.min,
                               scene.fluid);
     apply_initial_velocity(scene.initial_velocity, solver.grid());
-    coupling::Simulation sim(tracker::SurfaceTracker(std::move(initial), scene.tracker),
-                             std::move(solver), scene.coupling.simulation);
+    return coupling::Simulation(tracker::SurfaceTracker(std::move(initial), scene.tracker),
+                                std::move(solver), scene.coupling.simulation);
+}
+
+RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
+                          const std::atomic<bool>& stop) {
+    std::string report;
+    coupling::Simulation sim = make_fluid_simulation(scene, &report);
+    const double dx = sim.fluid().grid().dx();
     if (!options.quiet)
         std::fprintf(stderr, "%s: %s; fluid grid %d x %d x %d, dx = %g m\n", scene.name.c_str(),
                      report.c_str(), sim.fluid().grid().nx(), sim.fluid().grid().ny(),

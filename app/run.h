@@ -43,6 +43,12 @@ struct RunResult {
 /// file). Throws InputError naming the file and the failed check for a bad mesh file.
 tracker::SurfaceMesh build_initial_surface(const Scene& scene, std::string* report = nullptr);
 
+/// The coupled simulation of a fluid scene as `meniscus run` sets it up: the grid from /domain
+/// (cubic cells, /domain/cells along x), the initial surface from /surface (build_initial_surface(),
+/// whose `report` it passes on), the fluid at rest except for the /initial_velocity regions.
+/// Throws what build_initial_surface() and the fluid solver throw.
+coupling::Simulation make_fluid_simulation(const Scene& scene, std::string* report = nullptr);
+
 /// Runs the scene, writing frames into options.out_dir. Stops cleanly at the next step boundary
 /// once `stop` becomes true (every file already written is complete).
 RunResult run_scene(const Scene& scene, const RunOptions& options, const std::atomic<bool>& stop);

@@ -45,33 +45,11 @@ app::Scene refined_scene(const std::string& name, int cells) {
     return scene;
 }
 
-/// The coupled simulation of `scene` as `meniscus run` builds it.
-std::unique_ptr<coupling::Simulation> make_simulation(const app::Scene& scene) {
-    const double dx = scene.domain.size.x() / scene.domain.cells;
-    const auto cells_along = [&](double size) {
-        return std::max(1, static_cast<int>(std::lround(size / dx)));
-    };
-    fluid::FluidSolver solver(scene.domain.cells, cells_along(scene.domain.size.y()),
-                              cells_along(scene.domain.size.z()), dx, scene.domain.min,
-                              scene.fluid);
-    for (int axis = 0; axis < 3; ++axis) {
-        fluid::Array3<double>& u = solver.grid().velocity(axis);
-        for (int k = 0; k < u.nk(); ++k)
-            for (int j = 0; j < u.nj(); ++j)
-                for (int i = 0; i < u.ni(); ++i)
-                    for (const app::VelocityRegion& region : scene.initial_velocity)
-                        if (region.shape->value(solver.grid().face_centre(axis, i, j, k)) < 0.0)
-                            u(i, j, k) = region.velocity[axis];
-    }
-    return std::make_unique<coupling::Simulation>(
-        tracker::SurfaceTracker(app::build_initial_surface(scene), scene.tracker),
-        std::move(solver), scene.coupling.simulation);
-}
-
 void coupled_step(benchmark::State& state, const std::string& name) {
     const app::Scene scene =
         refined_scene(name, env_int("MENISCUS_BENCH_CELLS", DEFAULT_LONGEST_AXIS_CELLS));
-    std::unique_ptr<coupling::Simulation> sim = make_simulation(scene);
+    std::unique_ptr<coupling::Simulation> sim =
+        std::make_unique<coupling::Simulation>(app::make_fluid_simulation(scene));
     const fluid::MacGrid& grid = sim->fluid().grid();
     double rasterize = 0.0, fluid_step = 0.0, interpolate = 0.0, tracker_step = 0.0, dt = 0.0;
     const int initial_triangles = sim->tracker().mesh().count_live_triangles();
