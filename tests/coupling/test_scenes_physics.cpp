@@ -90,7 +90,8 @@ void expect_phase_volumes_kept(const std::vector<Json>& lines, double box_volume
     EXPECT_LT(max_relative_drift(other), PHASE_VOLUME_TOLERANCE);
 }
 
-TEST(ScenePhysics, OscillatingDropHasLambsFrequency) {
+/// scenes/oscillating_drop.json (two-phase as shipped, or with the air as void) against Lamb.
+void expect_lamb_frequency(bool free_surface) {
     // scenes/oscillating_drop.json as shipped (16 cells per diameter) for 1.3 Lamb periods.
     // The deformation d = a_x − (a_y + a_z)/2 comes from the exact volume moments of the mesh
     // after every step (a_d = sqrt(5⟨(x_d − c_d)²⟩), exact for an ellipsoid); ω is the
@@ -102,12 +103,14 @@ TEST(ScenePhysics, OscillatingDropHasLambsFrequency) {
     constexpr double FREQUENCY_TOLERANCE = 0.05;
     Scene scene = load_scene(scene_path("oscillating_drop"));
     scene.tracker.verify_intersection_free = true;
+    if (free_surface)
+        scene.fluid.mode = fluid::FluidMode::free_surface;
     coupling::Simulation sim = make_fluid_simulation(scene);
     const VolumeMoments m0 = volume_moments(sim.tracker().mesh());
     const double radius = std::cbrt(3.0 * m0.volume / (4.0 * M_PI));
     const fluid::PhaseOptions& phases = scene.fluid.phases;
     const double omega =
-        lamb_omega(2, phases.sigma, radius, phases.rho_liquid, phases.rho_gas);
+        lamb_omega(2, phases.sigma, radius, phases.rho_liquid, free_surface ? 0.0 : phases.rho_gas);
     std::vector<double> deformation;
     const FluidRunRecord r =
         run_sampled(sim, PERIODS * 2.0 * M_PI / omega, [&](const coupling::Simulation& s) {
@@ -118,10 +121,11 @@ TEST(ScenePhysics, OscillatingDropHasLambsFrequency) {
     EXPECT_TRUE(r.pressure_converged);
     EXPECT_EQ(r.max_intersecting_pairs, 0);
     const OscillationFit fit = fit_damped_oscillation(r.t, deformation, 0.5 * omega, 1.5 * omega);
-    std::printf("[ measured ] oscillating drop, %d cells per diameter, %lld steps: period %.3f ms, "
-                "Lamb %.3f ms (%+.2f %%); amplitude %.4f mm (initial deformation %.4f mm), "
+    std::printf("[ measured ] oscillating drop (%s), %d cells per diameter, %lld steps: period "
+                "%.3f ms, Lamb %.3f ms (%+.2f %%); amplitude %.4f mm (initial deformation %.4f mm), "
                 "decay rate %.3g 1/s, fit rms %.2e mm\n",
-                scene.domain.cells / 2, r.steps, 2e3 * M_PI / fit.omega, 2e3 * M_PI / omega,
+                free_surface ? "free surface" : "two-phase", scene.domain.cells / 2, r.steps,
+                2e3 * M_PI / fit.omega, 2e3 * M_PI / omega,
                 100.0 * (fit.omega / omega - 1.0), 1e3 * fit.amplitude,
                 1e3 * (deformation.front() - fit.offset), fit.decay_rate, 1e3 * fit.rms_residual);
     EXPECT_NEAR(fit.omega, omega, FREQUENCY_TOLERANCE * omega);
@@ -131,6 +135,14 @@ TEST(ScenePhysics, OscillatingDropHasLambsFrequency) {
     EXPECT_NEAR(fit.amplitude, deformation.front() - fit.offset,
                 0.2 * (deformation.front() - fit.offset));
     EXPECT_LT(max_relative_drift(r.enclosed_volume), PHASE_VOLUME_TOLERANCE);
+}
+
+TEST(ScenePhysics, OscillatingDropHasLambsFrequency) { expect_lamb_frequency(false); }
+
+TEST(ScenePhysics, FreeSurfaceOscillatingDropHasLambsFrequencyInAVoid) {
+    // Issue #7 item 6: the same drop with the air as void (free-surface mode, no gas solve);
+    // Lamb's l = 2 frequency with no outer fluid, ω² = 8σ/(ρR³).
+    expect_lamb_frequency(true);
 }
 
 TEST(ScenePhysics, JetPinchQuickPinchesIntoDrops) {
