@@ -566,13 +566,11 @@ struct Runner {
         // Quick: drop_merge until the drops have merged (10 of 30 frames). Full: the shipped
         // scenes to their end. (The quick jet pinch-off is a suite test,
         // tests/coupling/test_scenes_physics.cpp.)
-        std::vector<Case> cases;
-        if (options.full)
-            cases = {{"drop_merge", 0, 2, 1, true},
-                     {"bubble_merge", 0, 2, 1, true},
-                     {"jet_pinch", 0, 1, 2, false}};
-        else
-            cases = {{"drop_merge", 10, 2, 1, true}};
+        const std::vector<Case> cases =
+            options.full ? std::vector<Case>{{"drop_merge", 0, 2, 1, true},
+                                             {"bubble_merge", 0, 2, 1, true},
+                                             {"jet_pinch", 0, 1, 2, false}}
+                         : std::vector<Case>{{"drop_merge", 10, 2, 1, true}};
         Json runs = Json::array();
         for (const Case& c : cases) {
             Scene scene = load_scene(std::string(MENISCUS_SCENES_DIR) + "/" + c.scene + ".json");
