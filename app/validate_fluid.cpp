@@ -209,6 +209,7 @@ struct Runner {
         }
         out.results["B1"] = {{"runs", runs},
                              {"t_end", end},
+                             {"velocity_scale", std::sqrt(SIGMA / (RHO_L * diameter))},
                              {"capillary_time", capillary_time},
                              {"viscous_time", diameter * diameter * RHO_L / MU_L}};
         md << "## B1 — static drop (Laplace)\n\n"
@@ -425,6 +426,7 @@ struct Runner {
         out.results["B3"] = {{"runs", Json::array({run})},
                              {"theory_rate", rate},
                              {"kR", k * JET_R},
+                             {"radius", JET_R},
                              {"capillary_time", capillary_time},
                              {"t_end", end}};
         md << "## B3 — Rayleigh–Plateau\n\n"
@@ -683,6 +685,12 @@ import matplotlib.pyplot as plt
 out = sys.argv[1]
 b = json.load(open(os.path.join(out, "results.json"))).get("part_b", {})
 
+def damped_fit(r, t):
+    """The fitted offset + e^{-gt}(A cos wt + B sin wt) of a B2/B4 run at times t."""
+    w, g, c = r["omega"], r["decay_rate"], r["offset"]
+    A, B = r["cos_coefficient"], r["sin_coefficient"]
+    return [c + math.exp(-g * x) * (A * math.cos(w * x) + B * math.sin(w * x)) for x in t]
+
 def save(fig, name):
     fig.tight_layout()
     fig.savefig(os.path.join(out, name), dpi=120)
@@ -692,9 +700,8 @@ if "B1" in b:
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for r in b["B1"]["runs"]:
         s = r["series"]
-        D = 0.004
-        scale = math.sqrt(1000.0 * D / 0.0728)
-        ax.semilogy([1e3 * t for t in s["t"]], [max(u * scale, 1e-12) for u in s["max_speed"]],
+        scale = b["B1"]["velocity_scale"]
+        ax.semilogy([1e3 * t for t in s["t"]], [max(u / scale, 1e-12) for u in s["max_speed"]],
                     label="%d cells per D" % r["cells_per_diameter"])
     ax.set_xlabel("t (ms)")
     ax.set_ylabel("max|u| sqrt(rho D / sigma)")
@@ -712,10 +719,8 @@ if "B2" in b:
         d = s["deformation"]
         ax.plot([1e3 * x for x in t], [1e3 * y for y in d], ".", ms=2,
                 label="%d cells per D (measured)" % r["cells_per_diameter"])
-        # Fitted curve: offset + amplitude e^{-gt} cos(w t + phase); phase from the first sample.
-        w, g, c = r["omega"], r["decay_rate"], r["offset"]
-        A, B = r["cos_coefficient"], r["sin_coefficient"]
-        ax.plot([1e3 * x for x in t], [1e3 * (c + math.exp(-g * x) * (A * math.cos(w * x) + B * math.sin(w * x))) for x in t],
+        w = r["omega"]
+        ax.plot([1e3 * x for x in t], [1e3 * y for y in damped_fit(r, t)],
                 "-", lw=1, label="fit: period %.2f ms" % (1e3 * 2 * math.pi / w))
         a0 = d[0] - r["offset"]
         ax.plot([1e3 * x for x in t], [1e3 * (r["offset"] + a0 * math.cos(w0 * x)) for x in t], "k:",
@@ -734,7 +739,7 @@ if "B3" in b:
     for r in b["B3"]["runs"]:
         s = r["series"]
         t = s["t"]
-        R = 0.0006
+        R = b["B3"]["radius"]
         ax.semilogy([1e3 * x for x in t], [max(a / R, 1e-6) for a in s["amplitude"]], ".", ms=2,
                     label="measured (%d cells per wavelength)" % r["cells_per_wavelength"])
         tf = [x for x in t if x <= r["fit_t_end"]]
@@ -760,10 +765,7 @@ if "B4" in b:
         t = s["t"]
         a = s["amplitude"]
         ax.plot(t, a, ".", ms=2, label="measured (%d cells per wavelength)" % r["cells_per_wavelength"])
-        w, g, c = r["omega"], r["decay_rate"], r["offset"]
-        A, B = r["cos_coefficient"], r["sin_coefficient"]
-        ax.plot(t, [c + math.exp(-g * x) * (A * math.cos(w * x) + B * math.sin(w * x)) for x in t], "-", lw=1,
-                label="fit: omega = %.3f" % w)
+        ax.plot(t, damped_fit(r, t), "-", lw=1, label="fit: omega = %.3f" % r["omega"])
         ax.plot(t, [a[0] * math.cos(w0 * x) for x in t], "k:", lw=1, label="inviscid: omega0 = %.3f" % w0)
     ax.set_xlabel("t")
     ax.set_ylabel("amplitude of cos(kx)")
