@@ -34,11 +34,21 @@ constexpr double PAPER_A1_L1_COARSE = 0.00114493;
 constexpr double A1_L1_COARSE_BOUND = 2.0 * PAPER_A1_L1_COARSE;
 /// Sphere under mean-curvature flow: vertex distance to the exact R(t), relative to R.
 constexpr double MCF_RELATIVE_VERTEX_ERROR = 5e-3;
-/// A2 dumbbell at ξ = 0.04 against the quick level-set reference (Δx = 0.02): L1 measured
-/// 5.5e-4 (paper 2.6e-4 against its own, finer reference); the quick reference's two grids
+/// Paper Table 4.3, dumbbell at ξ = 0.04.
+constexpr double PAPER_A2_L1_COARSE = 2.62302e-4;
+/// A2 dumbbell at ξ = 0.04 against the primary, axisymmetric reference (quick: Δx = 0.005):
+/// L1 measured 2.9e-4 (paper 2.6e-4; L∞ 2.9e-3 against the paper's 6.2e-4, at the pinched
+/// tips, reported not asserted). The bound leaves room for remeshing changes.
+constexpr double A2_QUICK_L1_BOUND = 2.0 * PAPER_A2_L1_COARSE;
+/// The axisymmetric reference's two quick grids (Δx = 0.01, 0.005) differ by 2.5e-5 on average
+/// and 1.5e-4 at most at the mesh points: the reference resolves the mesh's error, whose
+/// average must be at least this many times the reference's self-difference (measured 12).
+constexpr double A2_REFERENCE_RESOLUTION_FACTOR = 4.0;
+constexpr double A2_QUICK_REFERENCE_MAX_DIFFERENCE_BOUND = 5e-4;
+/// Against the second, OpenVDB reference (Δx = 0.02): L1 measured 6.3e-4; its two grids
 /// (Δx = 0.04, 0.02) differ by 1.4e-3 on average at the mesh points, so neither bound is tight.
-constexpr double A2_QUICK_L1_BOUND = 1.5e-3;
-constexpr double A2_QUICK_REFERENCE_DIFFERENCE_BOUND = 3e-3;
+constexpr double A2_QUICK_OPENVDB_L1_BOUND = 1.5e-3;
+constexpr double A2_QUICK_OPENVDB_REFERENCE_DIFFERENCE_BOUND = 3e-3;
 /// Enright quick variant (period 1, ξ = 0.02): relative volume change bound, percent.
 constexpr double ENRIGHT_QUICK_VOLUME_PERCENT = 0.5;
 /// Enright quick: the surface returns near the initial sphere (L∞ distance, m; ξ = 0.02).
@@ -149,13 +159,21 @@ TEST_F(QuickValidation, DumbbellPinchesOffNearTheLevelSetReference) {
     EXPECT_TRUE(d[0]["completed"].get<bool>());
     EXPECT_EQ(d[0]["final_components"].get<int>(), 2);
     ASSERT_FALSE(d[0]["pinch_off_time"].is_null());
+    const Json& e = d[0]["error"];
+    const Json& self = d[0]["reference_difference"];
+    std::cout << "[ measured ] A2 dumbbell ξ=0.04 vs axisymmetric reference: L∞ " << e["linf"]
+              << ", L1 " << e["l1"] << " (paper " << PAPER_A2_L1_COARSE
+              << "); reference self-difference max " << self["linf"] << ", mean " << self["l1"]
+              << "; vs OpenVDB reference: L∞ " << d[0]["openvdb_error"]["linf"] << ", L1 "
+              << d[0]["openvdb_error"]["l1"] << "\n";
     EXPECT_TRUE(d[0]["error_within_reference_band"].get<bool>());
-    std::cout << "[ measured ] A2 dumbbell ξ=0.04 vs level-set reference: L∞ "
-              << d[0]["error"]["linf"] << ", L1 " << d[0]["error"]["l1"]
-              << "; reference self-difference mean " << d[0]["reference_difference"]["l1"] << "\n";
-    EXPECT_LT(d[0]["error"]["l1"].get<double>(), A2_QUICK_L1_BOUND);
-    EXPECT_LT(d[0]["reference_difference"]["l1"].get<double>(),
-              A2_QUICK_REFERENCE_DIFFERENCE_BOUND);
+    EXPECT_LT(e["l1"].get<double>(), A2_QUICK_L1_BOUND);
+    EXPECT_LT(self["linf"].get<double>(), A2_QUICK_REFERENCE_MAX_DIFFERENCE_BOUND);
+    EXPECT_GT(e["l1"].get<double>(), A2_REFERENCE_RESOLUTION_FACTOR * self["l1"].get<double>());
+    EXPECT_TRUE(d[0]["openvdb_error_within_reference_band"].get<bool>());
+    EXPECT_LT(d[0]["openvdb_error"]["l1"].get<double>(), A2_QUICK_OPENVDB_L1_BOUND);
+    EXPECT_LT(d[0]["openvdb_reference_difference"]["l1"].get<double>(),
+              A2_QUICK_OPENVDB_REFERENCE_DIFFERENCE_BOUND);
 }
 
 TEST_F(QuickValidation, EnrightQuickConservesVolumeAndReturns) {
