@@ -47,6 +47,11 @@ void RemeshOptions::validate() const {
     require(std::isfinite(flip_fold_weight) && flip_fold_weight >= 0.0,
             "RemeshOptions::flip_fold_weight", "must be finite and >= 0");
     require(smoothing_iterations >= 0, "RemeshOptions::smoothing_iterations", "must be >= 0");
+    require(split_fit_residual_fraction > 0.0 && split_fit_residual_fraction <= 1.0,
+            "RemeshOptions::split_fit_residual_fraction", "must be in (0, 1]");
+    require(smoothing_unfitted_min_angle_degrees >= 0.0 &&
+                smoothing_unfitted_min_angle_degrees <= 60.0,
+            "RemeshOptions::smoothing_unfitted_min_angle_degrees", "must be in [0, 60]");
     require(std::isfinite(smoothing_step_fraction) && smoothing_step_fraction > 0.0 &&
                 smoothing_step_fraction <= 1.0,
             "RemeshOptions::smoothing_step_fraction", "must be in (0, 1]");

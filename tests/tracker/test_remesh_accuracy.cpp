@@ -49,6 +49,8 @@ TEST(RemeshAccuracy, SmoothingMovesEachVertexAloneWithoutChangingTheVolume) {
     const SurfaceMesh mesh = jittered_sphere(0.3);
     const double volume = enclosed_volume(mesh);
     RemeshOptions options;
+    options.smoothing_onto_fitted_surface = false;  // the tangent-plane rule, used where no fit
+    options.smoothing_unfitted_min_angle_degrees = 60.0;
     const std::vector<Vec3> d = null_space_displacements(mesh, options);
     int moved = 0;
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {

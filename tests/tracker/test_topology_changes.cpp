@@ -133,7 +133,22 @@ TEST(Merge, SpheresPushedTogetherMergeWhileEveryStepStaysValidAndIntersectionFre
         mesh.compact();
     }
     EXPECT_GE(merges, 1);
-    EXPECT_EQ(triangle_components(mesh).count, 1);
+    // One body. A ring of zips around the contact may close over a film of gas and trap it: a
+    // separate, inward-facing component (negative volume) that is correct topology, not a
+    // failure (with fitted smoothing, step 10 traps a 12-triangle pocket of −1.2e-6 m³).
+    const Components components = triangle_components(mesh);
+    const std::vector<double> volumes = component_volumes(mesh, components);
+    int bodies = 0;
+    double body_volume = 0.0, pocket_volume = 0.0;
+    for (double v : volumes)
+        if (v > 0.0) {
+            ++bodies;
+            body_volume += v;
+        } else {
+            pocket_volume -= v;
+        }
+    EXPECT_EQ(bodies, 1);
+    EXPECT_LT(pocket_volume, 1e-3 * body_volume);
 }
 
 TEST(Merge, FarApartSpheresDoNotMergeAndMergingOffDoesNothing) {

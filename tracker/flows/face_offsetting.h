@@ -77,8 +77,10 @@ struct FaceOffsettingOptions {
     /// spread of the face normals), a bias that accumulates (A1 at ξ = 0.04: vertices 1.1e-3
     /// inside the exact spheres at t = 2 with 0, 5e-4 with 20). Sharper creases and concave
     /// vertices follow the entropy rule above.
-    /// Off (0) by default: at ξ = 0.01 it raised A1's L∞ (neck) from 1.35e-3 to 1.74e-3 while
-    /// L1 fell only 2.33e-4 → 2.24e-4 (issue #5, open).
+    /// Off (0) by default. With split points and smoothing moves on a fitted surface
+    /// (remesh/surface_fit.h), A1 at t = 2 with 0 / 20: L∞ 4.97e-3 / 4.94e-3, 2.08e-3 / 2.50e-3,
+    /// 9.99e-4 / 1.57e-3 at ξ = 0.04, 0.02, 0.01; L1 1.00e-3 / 6.57e-4, 3.26e-4 / 2.64e-4,
+    /// 1.22e-4 / 1.28e-4: it trades the neck's L∞ for the spheres' L1.
     double smooth_dihedral_degrees = 0.0;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };

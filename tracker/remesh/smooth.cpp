@@ -1,8 +1,11 @@
 #include "tracker/remesh/smooth.h"
 
 #include "tracker/quadric.h"
+#include "tracker/remesh/surface_fit.h"
 
 #include <chrono>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 namespace meniscus::tracker {
@@ -11,6 +14,20 @@ namespace {
 
 /// The smoothing pseudo-trajectory lasts one unit of pseudo-time (only displacements matter).
 constexpr double PSEUDO_STEP_DURATION = 1.0;
+
+/// Smallest interior angle (radians) of the triangles around vertex vi.
+double smallest_angle_around(const SurfaceMesh& mesh, int vi) {
+    double smallest = M_PI;
+    for (int ti : mesh.vertex_triangles(vi)) {
+        const Triangle& t = mesh.triangle(ti);
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 a = mesh.position(t[(k + 1) % 3]) - mesh.position(t[k]);
+            const Vec3 b = mesh.position(t[(k + 2) % 3]) - mesh.position(t[k]);
+            smallest = std::min(smallest, std::atan2(a.cross(b).norm(), a.dot(b)));
+        }
+    }
+    return smallest;
+}
 
 }  // namespace
 
@@ -34,6 +51,7 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
     const FeatureThresholds thresholds{options.ridge_eigenvalue_ratio,
                                        options.corner_eigenvalue_ratio};
     std::vector<Vec3> displacement(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
+    const double unfitted_min_angle = options.smoothing_unfitted_min_angle_degrees * M_PI / 180.0;
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
         if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty())
             continue;
@@ -63,6 +81,17 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
             continue;
         const Vec3 towards = weighted_centroid / total_area - mesh.position(vi);
         Vec3 d = options.smoothing_step_fraction * (q.null_space_projector() * towards);
+        if (options.smoothing_onto_fitted_surface && q.feature == VertexFeature::smooth) {
+            const Vec3& x = mesh.position(vi);
+            if (const std::optional<Vec3> p = fitted_vertex_point(mesh, vi, x + d)) {
+                displacement[static_cast<size_t>(vi)] = *p - x;
+                continue;
+            }
+            // No quadratic fits here (a crease or an under-resolved fillet): a tangent-plane move
+            // would leave the surface by about δ²κ/2, so move only to repair a poor triangle.
+            if (smallest_angle_around(mesh, vi) >= unfitted_min_angle)
+                continue;
+        }
         if (options.smoothing_preserves_volume) {
             const Vec3 g = vertex_volume_gradient(mesh, vi);
             const double g2 = g.squaredNorm();

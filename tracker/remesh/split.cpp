@@ -3,6 +3,8 @@
 #include "tracker/remesh/butterfly.h"
 #include "tracker/remesh/element_hash.h"
 #include "tracker/remesh/local_safety.h"
+#include "tracker/remesh/surface_fit.h"
+#include "tracker/quadric.h"
 
 #include <algorithm>
 #include <chrono>
@@ -38,6 +40,10 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
     const auto start = std::chrono::steady_clock::now();
     SplitReport report;
     const double alpha = remesh_limits(options, context.xi).max_edge_length;
+    const FeatureThresholds thresholds{options.ridge_eigenvalue_ratio,
+                                       options.corner_eigenvalue_ratio};
+    SurfaceFitOptions fit;
+    fit.max_residual_fraction = options.split_fit_residual_fraction;
     // Built on the first collision check (a pass with nothing to do never pays for it), then
     // kept current through every mutation.
     std::unique_ptr<ElementHash> hash;
@@ -74,7 +80,20 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
                 ++report.skipped_nonmanifold;
                 continue;
             }
-            const std::optional<Vec3> butterfly = butterfly_point(mesh, ei);
+            // Where the new vertex goes (named for the paper's rule, which is the last resort).
+            std::optional<Vec3> butterfly;
+            if (options.split_on_fitted_surface) {
+                if (vertex_quadric(mesh, e[0], thresholds).feature == VertexFeature::smooth &&
+                    vertex_quadric(mesh, e[1], thresholds).feature == VertexFeature::smooth)
+                    butterfly = fitted_edge_point(mesh, ei, fit);
+                if (butterfly) {
+                    ++report.fitted;
+                } else if ((butterfly = arc_edge_point(mesh, ei))) {
+                    ++report.arc;
+                }
+            }
+            if (!butterfly)
+                butterfly = butterfly_point(mesh, ei);
             const Vec3 midpoint = edge_midpoint(mesh, ei);
             std::vector<int> touched = {e[0], e[1]};
             for (int ti : mesh.edge_triangles(ei))

@@ -13,6 +13,8 @@ namespace meniscus::tracker {
 /// What a split pass did.
 struct SplitReport {
     int splits = 0;                 ///< edges split
+    int fitted = 0;                 ///< of those, aimed at the fitted surface (surface_fit.h)
+    int arc = 0;                    ///< of those, aimed at the circular-arc point (surface_fit.h)
     int butterfly_collides = 0;     ///< of those, kept at the midpoint: butterfly motion collided
     int butterfly_unavailable = 0;  ///< of those, at the midpoint: no butterfly stencil
     int skipped_boundary = 0;       ///< long boundary edges left alone (§4.4)
