@@ -3,6 +3,9 @@
 #include "tracker/quadric.h"
 #include "tracker/remesh/surface_fit.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <chrono>
 #include <algorithm>
 #include <cmath>
@@ -14,6 +17,8 @@ namespace {
 
 /// The smoothing pseudo-trajectory lasts one unit of pseudo-time (only displacements matter).
 constexpr double PSEUDO_STEP_DURATION = 1.0;
+/// Grain of the parallel loop over vertices.
+constexpr int VERTICES_PER_TASK = 256;
 
 /// Smallest interior angle (radians) of the triangles around vertex vi.
 double smallest_angle_around(const SurfaceMesh& mesh, int vi) {
@@ -50,56 +55,71 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
                                            SmoothReport* counts) {
     const FeatureThresholds thresholds{options.ridge_eigenvalue_ratio,
                                        options.corner_eigenvalue_ratio};
-    std::vector<Vec3> displacement(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
+    const size_t n = static_cast<size_t>(mesh.num_vertices());
+    std::vector<Vec3> displacement(n, Vec3::Zero());
+    // What each vertex is, for the report (filled in parallel, counted after).
+    enum Kind : std::uint8_t { SKIPPED, BOUNDARY, CORNER, RIDGE, SMOOTH };
+    std::vector<std::uint8_t> kind(n, SKIPPED);
     const double unfitted_min_angle = options.smoothing_unfitted_min_angle_degrees * M_PI / 180.0;
-    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
-        if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty())
-            continue;
-        if (mesh.is_boundary_vertex(vi)) {
-            if (counts)
-                ++counts->boundary_vertices;
-            continue;
-        }
-        const VertexQuadric q = vertex_quadric(mesh, vi, thresholds);
-        if (q.feature == VertexFeature::corner) {
-            if (counts)
-                ++counts->corner_vertices;
-            continue;
-        }
-        if (q.feature == VertexFeature::ridge && counts)
-            ++counts->ridge_vertices;
-        Vec3 weighted_centroid = Vec3::Zero();
-        double total_area = 0.0;
-        for (int ti : mesh.vertex_triangles(vi)) {
-            const Triangle& t = mesh.triangle(ti);
-            const Vec3 &a = mesh.position(t[0]), &b = mesh.position(t[1]), &c = mesh.position(t[2]);
-            const double area = 0.5 * (b - a).cross(c - a).norm();
-            weighted_centroid += area * (a + b + c) / 3.0;
-            total_area += area;
-        }
-        if (!(total_area > 0.0))
-            continue;
-        const Vec3 towards = weighted_centroid / total_area - mesh.position(vi);
-        Vec3 d = options.smoothing_step_fraction * (q.null_space_projector() * towards);
-        if (options.smoothing_onto_fitted_surface && q.feature == VertexFeature::smooth) {
-            const Vec3& x = mesh.position(vi);
-            if (const std::optional<Vec3> p = fitted_vertex_point(mesh, vi, x + d)) {
-                displacement[static_cast<size_t>(vi)] = *p - x;
+    // Each vertex reads only the current positions: independent, and the fits make it worth
+    // spreading over the cores.
+    tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_vertices(), VERTICES_PER_TASK),
+                      [&](const tbb::blocked_range<int>& range) {
+        for (int vi = range.begin(); vi != range.end(); ++vi) {
+            const size_t slot = static_cast<size_t>(vi);
+            if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty())
+                continue;
+            if (mesh.is_boundary_vertex(vi)) {
+                kind[slot] = BOUNDARY;
                 continue;
             }
-            // No quadratic fits here (a crease or an under-resolved fillet): a tangent-plane move
-            // would leave the surface by about δ²κ/2, so move only to repair a poor triangle.
-            if (smallest_angle_around(mesh, vi) >= unfitted_min_angle)
+            const VertexQuadric q = vertex_quadric(mesh, vi, thresholds);
+            if (q.feature == VertexFeature::corner) {
+                kind[slot] = CORNER;
                 continue;
+            }
+            kind[slot] = q.feature == VertexFeature::ridge ? RIDGE : SMOOTH;
+            Vec3 weighted_centroid = Vec3::Zero();
+            double total_area = 0.0;
+            for (int ti : mesh.vertex_triangles(vi)) {
+                const Triangle& t = mesh.triangle(ti);
+                const Vec3 &a = mesh.position(t[0]), &b = mesh.position(t[1]),
+                           &c = mesh.position(t[2]);
+                const double area = 0.5 * (b - a).cross(c - a).norm();
+                weighted_centroid += area * (a + b + c) / 3.0;
+                total_area += area;
+            }
+            if (!(total_area > 0.0))
+                continue;
+            const Vec3 towards = weighted_centroid / total_area - mesh.position(vi);
+            Vec3 d = options.smoothing_step_fraction * (q.null_space_projector() * towards);
+            if (options.smoothing_onto_fitted_surface && q.feature == VertexFeature::smooth) {
+                const Vec3& x = mesh.position(vi);
+                if (const std::optional<Vec3> p = fitted_vertex_point(mesh, vi, x + d)) {
+                    displacement[slot] = *p - x;
+                    continue;
+                }
+                // No quadratic fits here (a crease or an under-resolved fillet): a tangent-plane
+                // move would leave the surface by about δ²κ/2, so move only to repair a poor
+                // triangle.
+                if (smallest_angle_around(mesh, vi) >= unfitted_min_angle)
+                    continue;
+            }
+            if (options.smoothing_preserves_volume) {
+                const Vec3 g = vertex_volume_gradient(mesh, vi);
+                const double g2 = g.squaredNorm();
+                if (g2 > 0.0)
+                    d -= g.dot(d) / g2 * g;
+            }
+            displacement[slot] = d;
         }
-        if (options.smoothing_preserves_volume) {
-            const Vec3 g = vertex_volume_gradient(mesh, vi);
-            const double g2 = g.squaredNorm();
-            if (g2 > 0.0)
-                d -= g.dot(d) / g2 * g;
+    });
+    if (counts)
+        for (std::uint8_t k : kind) {
+            counts->boundary_vertices += k == BOUNDARY ? 1 : 0;
+            counts->corner_vertices += k == CORNER ? 1 : 0;
+            counts->ridge_vertices += k == RIDGE ? 1 : 0;
         }
-        displacement[static_cast<size_t>(vi)] = d;
-    }
     return displacement;
 }
 
