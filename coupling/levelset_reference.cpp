@@ -29,10 +29,8 @@ using Eigen::Vector3d;
 constexpr double CANDIDATE_VALUE_FACTOR = 1.5;
 /// Extra voxels around the shape's bounds scanned for band voxels.
 constexpr int SCAN_MARGIN_VOXELS = 2;
-/// Closest-point projection: outer iterations (tangential move + Newton re-projection), Newton
-/// steps per re-projection, and the tangential residual (fraction of Δx) that ends it.
-constexpr int PROJECTION_ITERATIONS = 50;
-constexpr int NEWTON_STEPS = 3;
+/// Closest-point projection (tracker::projected_signed_distance): the tangential residual
+/// (fraction of Δx) that ends it.
 constexpr double PROJECTION_TOLERANCE_FRACTION = 1e-7;
 /// Below this central-difference |∇φ| the curvature step uses the Laplacian (see the step).
 constexpr float DEGENERATE_GRADIENT = 0.5f;
@@ -42,34 +40,6 @@ constexpr double MAX_STEP_VOXELS = 0.5;
 constexpr double MAX_VOXELS_PER_AXIS = 2147483000.0;
 
 using Clock = std::chrono::steady_clock;
-
-/// Signed distance (negative inside) from x to the zero set of `shape`: x is projected onto the
-/// surface by Newton steps along ∇φ, then moved tangentially towards x and re-projected until
-/// x − p is normal to the surface at p (the first-order condition of the closest point p).
-double projected_signed_distance(const tracker::ImplicitShape& shape, const Vector3d& x,
-                                 double tolerance) {
-    const double value = shape.value(x);
-    Vector3d p = x;
-    for (int it = 0; it < PROJECTION_ITERATIONS; ++it) {
-        for (int k = 0; k < NEWTON_STEPS; ++k) {
-            const Vector3d g = shape.gradient(p);
-            const double g2 = g.squaredNorm();
-            if (!(g2 > 0.0))
-                break;
-            p -= shape.value(p) * g / g2;
-        }
-        const Vector3d g = shape.gradient(p);
-        if (!(g.squaredNorm() > 0.0))
-            break;
-        const Vector3d n = g.normalized();
-        const Vector3d r = x - p;
-        const Vector3d tangential = r - r.dot(n) * n;
-        if (tangential.norm() <= tolerance)
-            break;
-        p += tangential;
-    }
-    return std::copysign((x - p).norm(), value);
-}
 
 openvdb::FloatGrid::Ptr initial_band(const tracker::ImplicitShape& shape, double dx,
                                      int half_width) {
@@ -101,7 +71,7 @@ openvdb::FloatGrid::Ptr initial_band(const tracker::ImplicitShape& shape, double
                 const Vector3d x(i * dx, j * dx, k * dx);
                 if (!(std::abs(shape.value(x)) < candidate))
                     continue;
-                const double d = projected_signed_distance(shape, x, tolerance);
+                const double d = tracker::projected_signed_distance(shape, x, tolerance);
                 if (std::abs(d) < background)
                     acc.setValue(openvdb::Coord(i, j, k), static_cast<float>(d));
             }

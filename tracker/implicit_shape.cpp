@@ -358,4 +358,31 @@ ShapePtr make_difference(ShapePtr a, ShapePtr b) {
     return std::make_shared<Difference>(std::move(a), std::move(b));
 }
 
+double projected_signed_distance(const ImplicitShape& shape, const Eigen::Vector3d& x,
+                                 double tolerance) {
+    constexpr int PROJECTION_ROUNDS = 50;
+    constexpr int NEWTON_STEPS = 3;
+    const double value = shape.value(x);
+    Eigen::Vector3d p = x;
+    for (int it = 0; it < PROJECTION_ROUNDS; ++it) {
+        for (int k = 0; k < NEWTON_STEPS; ++k) {
+            const Eigen::Vector3d g = shape.gradient(p);
+            const double g2 = g.squaredNorm();
+            if (!(g2 > 0.0))
+                break;
+            p -= shape.value(p) * g / g2;
+        }
+        const Eigen::Vector3d g = shape.gradient(p);
+        if (!(g.squaredNorm() > 0.0))
+            break;
+        const Eigen::Vector3d n = g.normalized();
+        const Eigen::Vector3d r = x - p;
+        const Eigen::Vector3d tangential = r - r.dot(n) * n;
+        if (tangential.norm() <= tolerance)
+            break;
+        p += tangential;
+    }
+    return std::copysign((x - p).norm(), value);
+}
+
 }  // namespace meniscus::tracker

@@ -75,4 +75,13 @@ ShapePtr make_intersection(std::vector<ShapePtr> shapes);
 /// `a` minus `b` (max(φ_a, −φ_b)).
 ShapePtr make_difference(ShapePtr a, ShapePtr b);
 
+/// Signed distance (negative inside) from x to the zero set of `shape`, where the shape's value
+/// is only a bound on it (blends, CSG): x is projected onto the surface by Newton steps along
+/// ∇φ, then moved tangentially towards x and re-projected, until x − p is normal to the surface
+/// at p within `tolerance` (m; the first-order condition of the closest point p) or 50 rounds
+/// have run. The level-set references' initial conditions (coupling/levelset_reference,
+/// tracker/flows/axisymmetric_mcf_reference).
+double projected_signed_distance(const ImplicitShape& shape, const Eigen::Vector3d& x,
+                                 double tolerance);
+
 }  // namespace meniscus::tracker

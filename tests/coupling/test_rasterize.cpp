@@ -183,8 +183,9 @@ TEST(Rasterize, PoolFillingTheDomainWithAGasBubbleInside) {
             EXPECT_LT(raster.phi(n - 8, n - 8, n - 8), -2.0 * dx);
             EXPECT_EQ(raster.closest_triangle(n - 8, n - 8, n - 8), tracker::INVALID_INDEX);
             // On the pool's walls the corner cell is liquid at distance ½dx from three faces.
-            if (wall_offset == 0.0)
+            if (wall_offset == 0.0) {
                 EXPECT_NEAR(raster.phi(0, 0, 0), -0.5 * dx, 1e-12);
+            }
         }
     }
 }

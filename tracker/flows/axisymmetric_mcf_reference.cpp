@@ -28,10 +28,8 @@ constexpr double CURVATURE_BAND_MARGIN_VOXELS = 2.0;
 /// larger of twice that width and this fraction of the grid's radial extent: blended and CSG
 /// shapes' values are only bounds on the distance.
 constexpr double CANDIDATE_MARGIN_FRACTION = 0.05;
-/// Closest-point projection: outer iterations, Newton steps per re-projection, and the
-/// tangential residual (fraction of Δx) that ends it.
-constexpr int PROJECTION_ITERATIONS = 50;
-constexpr int NEWTON_STEPS = 3;
+/// Closest-point projection (projected_signed_distance): the tangential residual (fraction of
+/// Δx) that ends it.
 constexpr double PROJECTION_TOLERANCE_FRACTION = 1e-9;
 /// Grain size (cells) of the parallel loops.
 constexpr size_t GRAIN = 512;
@@ -79,33 +77,6 @@ inline double minmod(double x, double y) {
     if (x * y <= 0.0)
         return 0.0;
     return std::abs(x) < std::abs(y) ? x : y;
-}
-
-/// Signed distance (negative inside) from x to the zero set of `shape` by closest-point
-/// projection: Newton steps along ∇φ, then a tangential move towards x and re-projection, until
-/// x − p is normal to the surface at p.
-double projected_signed_distance(const ImplicitShape& shape, const Vec3& x, double tolerance) {
-    const double value = shape.value(x);
-    Vec3 p = x;
-    for (int it = 0; it < PROJECTION_ITERATIONS; ++it) {
-        for (int k = 0; k < NEWTON_STEPS; ++k) {
-            const Vec3 g = shape.gradient(p);
-            const double g2 = g.squaredNorm();
-            if (!(g2 > 0.0))
-                break;
-            p -= shape.value(p) * g / g2;
-        }
-        const Vec3 g = shape.gradient(p);
-        if (!(g.squaredNorm() > 0.0))
-            break;
-        const Vec3 n = g.normalized();
-        const Vec3 d = x - p;
-        const Vec3 tangential = d - d.dot(n) * n;
-        if (tangential.norm() <= tolerance)
-            break;
-        p += tangential;
-    }
-    return std::copysign((x - p).norm(), value);
 }
 
 /// The meridian grid and its narrow band while the flow runs.
