@@ -287,6 +287,12 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
               "null-space smoothing steps per improvement");
     v.number("smoothing_step_fraction", o.smoothing_step_fraction, Range{0.0, 1.0, true, false}, "",
              "fraction of the smoothing displacement applied per step");
+    v.boolean("split_on_fitted_surface", o.split_on_fitted_surface,
+              "put split vertices on a fitted quadratic surface or circular arc instead of the "
+              "butterfly point (more accurate shape; gains volume on the Enright test)");
+    v.boolean("smoothing_onto_fitted_surface", o.smoothing_onto_fitted_surface,
+              "smoothing moves smooth vertices along a fitted quadratic surface instead of "
+              "volume-neutrally in the tangent plane (more accurate shape; not volume-neutral)");
 }
 
 template <typename V>

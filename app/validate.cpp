@@ -393,6 +393,9 @@ void case_a1(Context& c) {
             s.shape = shape;
             s.tracker = paper_tracker_options();
             s.tracker.remesh.max_normal_change_degrees = A1_MAX_NORMAL_CHANGE_DEGREES;
+            // Shape accuracy over volume: split points and smoothing on the fitted surface.
+            s.tracker.remesh.split_on_fitted_surface = true;
+            s.tracker.remesh.smoothing_onto_fitted_surface = true;
             s.stepper = m.stepper;
             s.t_end = A1_END;
             s.max_dt = A1_DT;
@@ -409,6 +412,8 @@ void case_a1(Context& c) {
     s.shape = shape;
     s.tracker = paper_tracker_options();
     s.tracker.remesh.max_normal_change_degrees = A1_MAX_NORMAL_CHANGE_DEGREES;
+    s.tracker.remesh.split_on_fitted_surface = true;
+    s.tracker.remesh.smoothing_onto_fitted_surface = true;
     s.tracker.collision_safety = false;
     s.tracker.allow_topology_changes = false;
     s.stepper = methods.front().stepper;

@@ -108,6 +108,8 @@ int main(int argc, char** argv) {
     options.remesh.min_edge_fraction = MIN_EDGE_FRACTION;
     options.remesh.max_volume_change_fraction = VOLUME_CHANGE_FRACTION;
     options.remesh.max_normal_change_degrees = MAX_NORMAL_CHANGE_DEGREES;
+    options.remesh.split_on_fitted_surface = true;  // as validate's A1
+    options.remesh.smoothing_onto_fitted_surface = true;
     ImplicitMeshOptions mesh_options;
     mesh_options.edge_length = xi;
     SurfaceTracker tracker(mesh_implicit_shape(*shape, mesh_options), options);

@@ -165,9 +165,9 @@ TEST(SurfaceFit, FittedSmoothingKeepsVerticesOnTheSphere) {
     SurfaceMesh plane = fitted;
     RemeshOptions options;
     options.smoothing_iterations = 20;
+    options.smoothing_onto_fitted_surface = true;
     ImproveContext context;
     context.xi = 0.04;
-    ASSERT_TRUE(options.smoothing_onto_fitted_surface);
     EXPECT_GT(smooth_null_space(fitted, options, context).vertices_moved, 0);
     options.smoothing_onto_fitted_surface = false;
     smooth_null_space(plane, options, context);
@@ -190,6 +190,7 @@ TEST(SurfaceFit, SplitsOfASphereLandOnIt) {
     const int before = mesh.num_vertices();
     RemeshOptions options;
     options.max_edge_fraction = 0.75;
+    options.split_on_fitted_surface = true;
     ImproveContext context;
     context.xi = 0.04;
     const SplitReport r = split_long_edges(mesh, options, context);
