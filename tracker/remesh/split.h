@@ -1,8 +1,10 @@
 #pragma once
 /// \file Edge split (paper §3.5.1): edges longer than α get a new vertex, first at the midpoint
-/// (which cannot create an intersection), then moved to the butterfly point as a pseudo-motion
-/// checked by CCD; if that motion may collide the vertex stays at the midpoint. Boundary and
-/// non-manifold edges are never split (§3.5.1, §4.4).
+/// (which cannot create an intersection), then moved to its target as a pseudo-motion checked by
+/// CCD; if that motion may collide the vertex stays at the midpoint. The target is the butterfly
+/// point, or with RemeshOptions::split_on_fitted_surface the fitted-surface or circular-arc
+/// point of remesh/surface_fit.h where those exist. Boundary and non-manifold edges are never
+/// split (§3.5.1, §4.4).
 
 #include "tracker/mesh.h"
 #include "tracker/remesh/element_hash.h"
@@ -32,8 +34,8 @@ bool split_butterfly_collides(const SurfaceMesh& mesh, const ElementHash& hash, 
                               const Vec3& target);
 
 /// Splits every edge longer than α, longest first, sweeping until none is left or
-/// `options.max_split_passes` sweeps ran. With `context.collision_safety` off the butterfly
-/// point is used without a check.
+/// `options.max_split_passes` sweeps ran. With `context.collision_safety` off the target is
+/// used without a check.
 SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
                              const ImproveContext& context);
 
