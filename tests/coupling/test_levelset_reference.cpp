@@ -4,6 +4,7 @@
 #include "coupling/levelset_reference.h"
 
 #include "tracker/implicit_shape.h"
+#include "tests/sphere_samples.h"
 
 #include <gtest/gtest.h>
 
@@ -17,7 +18,6 @@ namespace {
 
 using Eigen::Vector3d;
 
-constexpr double PI = 3.14159265358979323846;
 constexpr double SPHERE_R0 = 0.3;
 /// Off the voxel lattice, so no symmetry of the grid helps.
 const Vector3d SPHERE_CENTER(0.0123, -0.0071, 0.0037);
@@ -27,15 +27,7 @@ constexpr int SPHERE_SAMPLES = 2000;
 
 /// Points spread evenly over the sphere of `radius` around SPHERE_CENTER (Fibonacci lattice).
 std::vector<Vector3d> sphere_points(double radius) {
-    std::vector<Vector3d> out;
-    const double golden_angle = PI * (3.0 - std::sqrt(5.0));
-    for (int i = 0; i < SPHERE_SAMPLES; ++i) {
-        const double z = 1.0 - 2.0 * (i + 0.5) / SPHERE_SAMPLES;
-        const double r = std::sqrt(1.0 - z * z);
-        const double a = golden_angle * i;
-        out.push_back(SPHERE_CENTER + radius * Vector3d(r * std::cos(a), r * std::sin(a), z));
-    }
-    return out;
+    return testing::fibonacci_sphere_points(SPHERE_CENTER, radius, SPHERE_SAMPLES);
 }
 
 /// max |φ_ref| over points of the exact sphere at SPHERE_END: the reference's radius error.

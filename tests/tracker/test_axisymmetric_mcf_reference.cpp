@@ -7,6 +7,7 @@
 
 #include "coupling/levelset_reference.h"
 #include "tracker/implicit_shape.h"
+#include "tests/sphere_samples.h"
 
 #include <gtest/gtest.h>
 
@@ -22,7 +23,6 @@
 namespace meniscus::tracker {
 namespace {
 
-constexpr double PI = 3.14159265358979323846;
 
 constexpr double SPHERE_R0 = 0.3;
 /// Half the extinction time R₀²/4: the radius falls from 0.3 to 0.212.
@@ -57,15 +57,7 @@ constexpr double MIN_DIFFERENCE_RATIO = 2.5;
 constexpr double OPENVDB_AGREEMENT = 4e-3;
 
 std::vector<Vec3> sphere_points(const Vec3& center, double radius) {
-    std::vector<Vec3> out;
-    const double golden_angle = PI * (3.0 - std::sqrt(5.0));
-    for (int i = 0; i < SPHERE_SAMPLES; ++i) {
-        const double z = 1.0 - 2.0 * (i + 0.5) / SPHERE_SAMPLES;
-        const double r = std::sqrt(1.0 - z * z);
-        const double a = golden_angle * i;
-        out.push_back(center + radius * Vec3(r * std::cos(a), r * std::sin(a), z));
-    }
-    return out;
+    return testing::fibonacci_sphere_points(center, radius, SPHERE_SAMPLES);
 }
 
 /// max |φ_ref| over the exact sphere at SPHERE_END.
