@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <utility>
 
 namespace meniscus::app {
 
@@ -22,10 +23,12 @@ std::string format_duration(double seconds) {
     return buf;
 }
 
-Progress::Progress(std::FILE* stream, bool quiet)
+Progress::Progress(std::FILE* stream, bool quiet, std::string unit, double min_line_seconds)
     : m_stream(stream),
       m_quiet(quiet),
       m_terminal(isatty(fileno(stream)) != 0),
+      m_unit(std::move(unit)),
+      m_min_line_seconds(min_line_seconds),
       m_start(std::chrono::steady_clock::now()) {}
 
 void Progress::frame_done(int frame, int frames, double time, const std::string& detail) {
@@ -38,13 +41,18 @@ void Progress::frame_done(int frame, int frames, double time, const std::string&
         const int filled = frames > 0 ? BAR_WIDTH * frame / frames : BAR_WIDTH;
         std::string bar(static_cast<size_t>(filled), '#');
         bar.resize(BAR_WIDTH, '.');
-        std::fprintf(m_stream, "\r\033[K[%s] frame %d/%d  t=%.4g s  ETA %s  %s", bar.c_str(), frame,
-                     frames, time, format_duration(eta).c_str(), detail.c_str());
+        std::fprintf(m_stream, "\r\033[K[%s] %s %d/%d  t=%.4g s  ETA %s  %s", bar.c_str(),
+                     m_unit.c_str(), frame, frames, time, format_duration(eta).c_str(),
+                     detail.c_str());
         m_drawn = true;
     } else {
-        std::fprintf(m_stream, "frame %d/%d t=%.6g s elapsed %s ETA %s %s\n", frame, frames, time,
-                     format_duration(elapsed).c_str(), format_duration(eta).c_str(),
-                     detail.c_str());
+        const bool due = m_last_line < 0 || elapsed - m_last_line >= m_min_line_seconds;
+        if (!due && frame < frames)
+            return;
+        m_last_line = elapsed;
+        std::fprintf(m_stream, "%s %d/%d t=%.6g s elapsed %s ETA %s %s\n", m_unit.c_str(), frame,
+                     frames, time, format_duration(elapsed).c_str(),
+                     format_duration(eta).c_str(), detail.c_str());
     }
     std::fflush(m_stream);
 }

@@ -9,8 +9,11 @@ namespace meniscus::app {
 
 class Progress {
 public:
-    /// `stream` is where progress goes (stderr); `quiet` silences it entirely.
-    Progress(std::FILE* stream, bool quiet);
+    /// `stream` is where progress goes (stderr); `quiet` silences it entirely. `unit` names
+    /// what is counted ("frame"; "%" for a share of a run). Off a terminal, a plain line is
+    /// written at most every `min_line_seconds` of wall time (the last one always).
+    Progress(std::FILE* stream, bool quiet, std::string unit = "frame",
+             double min_line_seconds = 0.0);
     /// Frame `frame` of `frames` is done at simulated time `time` (s); `detail` is appended.
     void frame_done(int frame, int frames, double time, const std::string& detail);
     /// Ends the bar (newline on a terminal).
@@ -20,8 +23,11 @@ private:
     std::FILE* m_stream;
     bool m_quiet;
     bool m_terminal;
+    std::string m_unit;
+    double m_min_line_seconds;
     bool m_drawn = false;
     std::chrono::steady_clock::time_point m_start;
+    double m_last_line = -1.0;  ///< elapsed seconds at the last plain line; < 0: none yet
 };
 
 /// "mm:ss" or "h:mm:ss" for a duration in seconds.

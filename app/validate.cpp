@@ -5,6 +5,7 @@
 
 #include "app/validate.h"
 
+#include "app/progress.h"
 #include "app/validate_fluid.h"
 #include "coupling/levelset_reference.h"
 #include "tracker/flows/axisymmetric_mcf_reference.h"
@@ -135,6 +136,8 @@ constexpr double STALL_FRACTION = 1e-6;
 /// A run stops when the mesh exceeds this many triangles (a field stretching the surface
 /// without bound would otherwise exhaust time and memory).
 constexpr int MAX_TRIANGLES = 400000;
+/// Off a terminal, a run's progress line is written at most this often (s of wall time).
+constexpr double PROGRESS_LINE_SECONDS = 30.0;
 /// Bound on steps per run.
 constexpr long MAX_STEPS = 2000000;
 /// Times closer than this fraction of the step to a breakpoint snap onto it.
@@ -212,6 +215,9 @@ RunResult run_tracked(const RunSpec& spec, bool quiet) {
     stops.push_back(spec.t_end);
     std::sort(stops.begin(), stops.end());
     int stalled = 0;
+    // Long runs (A4 at full length takes hours) show how far they have got.
+    Progress progress(stderr, quiet, "percent", PROGRESS_LINE_SECONDS);
+    int percent_done = 0;
     while (r.t < spec.t_end) {
         if (r.steps >= MAX_STEPS) {
             r.stop_reason = "step limit";
@@ -246,6 +252,15 @@ RunResult run_tracked(const RunSpec& spec, bool quiet) {
         r.min_triangles = std::min(r.min_triangles, triangles);
         r.max_triangles = std::max(r.max_triangles, triangles);
         record(pairs);
+        const int percent = static_cast<int>(std::floor(100.0 * r.t / spec.t_end));
+        if (percent > percent_done) {
+            percent_done = std::min(percent, 100);
+            char detail[160];
+            std::snprintf(detail, sizeof detail, "%s %s ξ=%g: step %ld, %d triangles, %d pairs",
+                          spec.case_id.c_str(), spec.label.c_str(), spec.xi_requested, r.steps,
+                          triangles, pairs);
+            progress.frame_done(percent_done, 100, r.t, detail);
+        }
         if (triangles > MAX_TRIANGLES) {
             r.stop_reason = "triangle limit";
             break;
@@ -256,6 +271,7 @@ RunResult run_tracked(const RunSpec& spec, bool quiet) {
             break;
         }
     }
+    progress.finish();
     r.completed = r.t >= spec.t_end;
     if (r.completed)
         r.stop_reason = "reached end";
