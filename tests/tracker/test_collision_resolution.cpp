@@ -1,6 +1,9 @@
 #include "tracker/collision_resolution.h"
+#include "tracker/flows/curl_noise.h"
+#include "tracker/flows/flow_runner.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/mesh_intersections.h"
+#include "tracker/mesh_io.h"
 #include "tracker/mesh_measures.h"
 #include "tracker/surface_tracker.h"
 
@@ -8,6 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include <random>
+#include <string>
 
 namespace meniscus::tracker {
 namespace {
@@ -233,6 +237,48 @@ TEST(CollisionStress, WithoutSafetyTheSameMotionIntersects) {
         worst = std::max(worst, tracker.integrate(v, 0.01).intersecting_pairs);
     }
     EXPECT_GT(worst, 0);
+}
+
+// Regression (A4 curl noise, collision safety on, ξ = 0.04): the step at t = 28.1 s has 707
+// CCD hits among thin sheets pressed together all over the surface. Impact zones appended a
+// pair found again as a second row beside its first, with another normal; the conflicting rows
+// made each round's solve create more contacts than it removed (47 → 3860 in ten rounds) and
+// the step never ended (a 35 000-row zone, over a minute per factorization). The mesh is the
+// run's state at that step, after remeshing.
+TEST(CollisionRegression, CurlNoiseSheetsAtT28ResolveInAFewImpactZoneRounds) {
+    const SurfaceMesh mesh =
+        to_surface_mesh(read_ply(std::string(MENISCUS_TEST_DATA_DIR) +
+                                 "/regression/curl_noise_a4_t28.1.ply"),
+                        "curl_noise_a4_t28.1.ply");
+    ASSERT_EQ(mesh.count_live_triangles(), 44794);
+    ASSERT_TRUE(find_self_intersections(mesh).triangle_pairs.empty());
+    // validate's A4 field (app/validate.cpp) and the run's time, step and ξ.
+    CurlNoiseOptions noise;
+    noise.planar = true;
+    noise.rms_speed = 0.05;
+    noise.base_wavelength = 0.5;
+    noise.time_frequency = 1.0;
+    const CurlNoiseField field(noise);
+    const FlowStep step = VelocityFieldStepper(field).step(mesh, 28.100000000000264, 0.05);
+    const double xi = 0.040977574596089125;
+    const std::vector<Vec3> x0 = mesh.positions();
+    std::vector<Vec3> x1 = x0;
+    for (size_t i = 0; i < x1.size(); ++i)
+        x1[i] += step.displacements[i];
+    CollisionOptions options;
+    options.proximity_epsilon = TrackerOptions{}.proximity_fraction * xi;
+    const CollisionReport r = resolve_collisions(mesh, x0, x1, step.dt, options);
+    EXPECT_GT(r.collisions_first_sweep, 500);  // the hard case is still exercised
+    EXPECT_GT(r.impact_zone_iterations, 0);
+    EXPECT_LE(r.impact_zone_iterations, 12);
+    EXPECT_LE(r.largest_impact_zone, 1000);
+    EXPECT_EQ(r.rigid_zone_iterations, 0);
+    EXPECT_EQ(r.step_shortenings, 0);
+    EXPECT_EQ(r.motion_fraction, 1.0);
+    EXPECT_TRUE(r.collision_free);
+    SurfaceMesh moved = mesh;
+    moved.set_positions(x1);
+    EXPECT_TRUE(find_self_intersections(moved).triangle_pairs.empty());
 }
 
 }  // namespace
