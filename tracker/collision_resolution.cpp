@@ -31,6 +31,12 @@ constexpr double IMPULSE_SEPARATION_FRACTION = 0.1;
 /// Relative Tikhonov regularization of the impact-zone system (redundant constraints make
 /// C M⁻¹ Cᵀ singular).
 constexpr double ZONE_REGULARIZATION = 1e-12;
+/// Active-set rounds of one impact zone's quadratic program (each one factorization); the
+/// detect/solve loop around it continues from wherever the last round left the zone.
+constexpr int MAX_ACTIVE_SET_ROUNDS = 8;
+/// A row outside the active set is violated when it misses its target by more than this
+/// fraction of the target.
+constexpr double ACTIVE_SET_TOLERANCE = 1e-3;
 /// Extra padding of the shared broad phase, in units of ε_p: the candidate pairs found once for
 /// the repulsion (static boxes at t0, padded ε_p/2) and the first CCD sweep (swept boxes) stay a
 /// superset for any later displacement within half of this of the one they were built for, so
@@ -199,13 +205,8 @@ public:
     /// Phase 3: impact zones (Harmon et al. 2008 inelastic projection, paper §3.8).
     /// Returns true when the motion is collision-free at the end.
     ///
-    /// A pair detected again (the same four vertices) replaces its row: the old row holds the
-    /// normal and weights of a contact that the last solve moved, and keeping both makes two
-    /// conflicting equality constraints on the same vertices. Kept side by side they made the
-    /// regularized system near-singular, its λ huge, and each round's solve caused more new
-    /// contacts than it removed (A4 curl noise at t = 28.1: 47 → 3860 fresh contacts in ten
-    /// rounds, a 23 000-row zone whose factorization took 28 s and growing; with replacement
-    /// the same step needs 6 rounds and 211 rows).
+    /// A pair detected again (the same four vertices, the same kind) replaces its row: the old
+    /// row holds the normal and weights of a contact that the last solve has moved.
     bool impact_zones(std::vector<Vec3>& d, CollisionReport& report) {
         std::vector<Contact> constraints;
         std::map<std::pair<std::array<int, 4>, bool>, size_t> row_of;  // a pair → its row
@@ -380,36 +381,113 @@ private:
             solve_zone(constraints, rows, d, report);
     }
 
-    /// One zone: A = C M⁻¹ Cᵀ is assembled sparse — rows r and s couple only through the
-    /// vertices they share, A_rs = Σ_v ā_rv ā_sv m_v⁻¹ (n_r · n_s) — and factored by sparse LDLᵀ.
+    /// One zone: the inelastic projection as the quadratic program of Harmon et al. 2008,
+    /// min ½‖Δd‖²_M subject to C(d + Δd) ≥ b — every contact separates by at least its target
+    /// — solved by an active set. The rows in the set are equalities, Δd = M⁻¹ Cᵀ λ with
+    /// (C M⁻¹ Cᵀ) λ = b − C d; a row with λ < 0 would pull its pair together and leaves the
+    /// set; a row outside the set that the correction leaves violated joins it. Equalities
+    /// alone fail when two rows describe nearly the same contact with different targets (a
+    /// point–triangle and an edge–edge contact at one place): the minimum-norm solution of
+    /// nearly dependent, inconsistent rows is huge, one λ large and positive and the other
+    /// large and negative, and its correction makes new contacts all over the zone (A4 curl
+    /// noise at t = 28.1: 49 → 5448 fresh contacts in 13 rounds, each solve slower).
     void solve_zone(const std::vector<Contact>& constraints, const std::vector<int>& rows,
                     std::vector<Vec3>& d, CollisionReport& report) const {
-        const int m = static_cast<int>(rows.size());
+        const auto row = [&](int r) -> const Contact& { return constraint(constraints, rows, r); };
+        const auto violation = [&](int r, const std::vector<Vec3>& dd) {
+            return row(r).target - relative_normal_displacement(row(r), dd);
+        };
+        std::vector<int> vertices;
+        for (int r = 0; r < static_cast<int>(rows.size()); ++r)
+            vertices.insert(vertices.end(), row(r).vertices.begin(), row(r).vertices.end());
+        std::sort(vertices.begin(), vertices.end());
+        const int zone_vertices = static_cast<int>(
+            std::unique(vertices.begin(), vertices.end()) - vertices.begin());
+        report.largest_impact_zone = std::max(report.largest_impact_zone, zone_vertices);
+
+        std::vector<int> active;  // indices into `rows`
+        double tolerance = 0.0;   // violations below this count as met
+        for (int r = 0; r < static_cast<int>(rows.size()); ++r) {
+            tolerance = std::max(tolerance, ACTIVE_SET_TOLERANCE * row(r).target);
+            if (violation(r, d) > 0.0)
+                active.push_back(r);
+        }
+        std::vector<std::uint8_t> in_active(rows.size(), 0);
+        std::vector<Vec3> trial;
+        bool have_solution = false;
+        std::vector<Vec3> solution;
+        for (int round = 0; round < MAX_ACTIVE_SET_ROUNDS && !active.empty(); ++round) {
+            Eigen::VectorXd lambda;
+            if (!solve_equalities(constraints, rows, active, d, lambda))
+                break;  // left to the rigid-zone fallback
+            std::vector<int> kept;
+            for (size_t i = 0; i < active.size(); ++i)
+                if (lambda[static_cast<Eigen::Index>(i)] >= 0.0)
+                    kept.push_back(active[i]);
+            if (kept.size() < active.size()) {
+                active = std::move(kept);
+                continue;
+            }
+            trial = d;
+            for (size_t i = 0; i < active.size(); ++i) {
+                const Contact& c = row(active[i]);
+                const double li = lambda[static_cast<Eigen::Index>(i)];
+                for (int k = 0; k < 4; ++k) {
+                    const auto v = static_cast<size_t>(c.vertices[k]);
+                    trial[v] += (li * c.weights[k] * m_inv_mass[v]) * c.normal;
+                }
+            }
+            solution = trial;
+            have_solution = true;
+            std::fill(in_active.begin(), in_active.end(), 0);
+            for (int r : active)
+                in_active[static_cast<size_t>(r)] = 1;
+            bool joined = false;
+            for (int r = 0; r < static_cast<int>(rows.size()); ++r)
+                if (!in_active[static_cast<size_t>(r)] && violation(r, trial) > tolerance) {
+                    active.push_back(r);
+                    joined = true;
+                }
+            if (!joined)
+                break;
+        }
+        if (have_solution)
+            d = std::move(solution);
+    }
+
+    /// λ of the rows `active` (indices into `rows`) held as equalities: A = C M⁻¹ Cᵀ assembled
+    /// sparse — rows r and s couple only through the vertices they share,
+    /// A_rs = Σ_v ā_rv ā_sv m_v⁻¹ (n_r · n_s) — and factored by sparse LDLᵀ. False when every
+    /// vertex is pinned or the factorization fails.
+    bool solve_equalities(const std::vector<Contact>& constraints, const std::vector<int>& rows,
+                          const std::vector<int>& active, const std::vector<Vec3>& d,
+                          Eigen::VectorXd& lambda) const {
+        const int m = static_cast<int>(active.size());
         // Rows touching each vertex, with the row's weight for it.
         std::vector<std::pair<int, std::pair<int, double>>> touches;  // (vertex, (row, ā))
-        touches.reserve(4 * rows.size());
+        touches.reserve(4 * active.size());
         Eigen::VectorXd rhs(m);
         for (int r = 0; r < m; ++r) {
-            const Contact& c = constraints[static_cast<size_t>(rows[static_cast<size_t>(r)])];
+            const Contact& c = constraint(constraints, rows, active[static_cast<size_t>(r)]);
             for (int k = 0; k < 4; ++k)
                 touches.push_back({c.vertices[k], {r, c.weights[k]}});
             rhs[r] = c.target - relative_normal_displacement(c, d);
         }
         std::sort(touches.begin(), touches.end());
-        int zone_vertices = 0;
         std::vector<Eigen::Triplet<double>> entries;
         for (size_t a = 0; a < touches.size();) {
             size_t b = a;
             while (b < touches.size() && touches[b].first == touches[a].first)
                 ++b;
-            ++zone_vertices;
             const double inv = m_inv_mass[static_cast<size_t>(touches[a].first)];
             if (inv > 0.0) {
                 for (size_t i = a; i < b; ++i)
                     for (size_t j = a; j < b; ++j) {
                         const int ri = touches[i].second.first, rj = touches[j].second.first;
-                        const Vec3& ni = constraint(constraints, rows, ri).normal;
-                        const Vec3& nj = constraint(constraints, rows, rj).normal;
+                        const Vec3& ni =
+                            constraint(constraints, rows, active[static_cast<size_t>(ri)]).normal;
+                        const Vec3& nj =
+                            constraint(constraints, rows, active[static_cast<size_t>(rj)]).normal;
                         entries.emplace_back(
                             ri, rj,
                             touches[i].second.second * touches[j].second.second * inv * ni.dot(nj));
@@ -417,28 +495,20 @@ private:
             }
             a = b;
         }
-        report.largest_impact_zone = std::max(report.largest_impact_zone, zone_vertices);
         Eigen::SparseMatrix<double> A(m, m);
         A.setFromTriplets(entries.begin(), entries.end());
         double scale = 0.0;
         for (int r = 0; r < m; ++r)
             scale = std::max(scale, A.coeff(r, r));
         if (!(scale > 0.0))
-            return;  // every vertex pinned
+            return false;  // every vertex pinned
         for (int r = 0; r < m; ++r)
             A.coeffRef(r, r) += ZONE_REGULARIZATION * scale;
-        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(A);
+        const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(A);
         if (ldlt.info() != Eigen::Success)
-            return;  // left to the rigid-zone fallback
-        const Eigen::VectorXd lambda = ldlt.solve(rhs);
-        // d ← d + M⁻¹ Cᵀ λ.
-        for (int r = 0; r < m; ++r) {
-            const Contact& c = constraint(constraints, rows, r);
-            for (int k = 0; k < 4; ++k) {
-                const auto v = static_cast<size_t>(c.vertices[k]);
-                d[v] += (lambda[r] * c.weights[k] * m_inv_mass[v]) * c.normal;
-            }
-        }
+            return false;
+        lambda = ldlt.solve(rhs);
+        return lambda.allFinite();
     }
 
     static const Contact& constraint(const std::vector<Contact>& constraints,

@@ -6,8 +6,9 @@
 /// Pipeline: (1) repulsion impulses for vertex–triangle and edge–edge proximities closer than
 /// ε_p at t0; (2) up to `impulse_sweeps` sweeps of CCD with per-collision inelastic impulses;
 /// (3) impact zones: colliding elements grouped by shared vertices and solved together,
-/// minimizing ‖u′ − u‖_M subject to zero relative normal velocity per collision
-/// (C M⁻¹ Cᵀ λ = C u), zones merging as new collisions appear, until none remains; (4) bounded
+/// minimizing ‖u′ − u‖_M subject to each collision's relative normal displacement reaching
+/// its small separating target (an inequality; active set of equalities C M⁻¹ Cᵀ λ = b − C u,
+/// λ ≥ 0), zones merging as new collisions appear, until none remains; (4) bounded
 /// fallbacks: rigid impact zones (each zone moves as a rigid body), then shortening the step
 /// (x_t1 pulled back towards x_t0), then — if still not free — no motion at all. Every loop has a
 /// bound; what was used is reported. Never prints, never loops forever.
