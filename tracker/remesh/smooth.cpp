@@ -1,13 +1,17 @@
 #include "tracker/remesh/smooth.h"
 
+#include "tracker/broadphase.h"
+#include "tracker/ccd.h"
 #include "tracker/quadric.h"
 #include "tracker/remesh/surface_fit.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include <chrono>
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 
@@ -15,10 +19,10 @@ namespace meniscus::tracker {
 
 namespace {
 
-/// The smoothing pseudo-trajectory lasts one unit of pseudo-time (only displacements matter).
-constexpr double PSEUDO_STEP_DURATION = 1.0;
 /// Grain of the parallel loop over vertices.
 constexpr int VERTICES_PER_TASK = 256;
+/// Grain of the parallel CCD loop over candidate pairs.
+constexpr size_t PAIRS_PER_TASK = 256;
 
 /// Smallest interior angle (radians) of the triangles around vertex vi.
 double smallest_angle_around(const SurfaceMesh& mesh, int vi) {
@@ -32,6 +36,65 @@ double smallest_angle_around(const SurfaceMesh& mesh, int vi) {
         }
     }
     return smallest;
+}
+
+/// Holds still (x_t1 = x_t0) every moving vertex of a vertex–triangle or edge–edge pair that may
+/// collide during the linear motion x_t0 → x_t1 (exact broad phase and CCD), until no pair may.
+/// Each round holds at least one more vertex (a colliding pair has a moving vertex, as x_t0 is
+/// intersection-free), so it ends; with every vertex held there is no motion left to collide.
+void hold_colliding_vertices(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
+                             std::vector<Vec3>& x_t1, SmoothReport& report) {
+    const auto moving = [&](int v) {
+        return x_t1[static_cast<size_t>(v)] != x_t0[static_cast<size_t>(v)];
+    };
+    for (;;) {
+        ++report.collision_rounds;
+        const BroadPhase broad(mesh, x_t0, x_t1, 0.0);
+        const std::vector<VertexTrianglePair> vt = broad.vertex_triangle_pairs();
+        const std::vector<EdgeEdgePair> ee = broad.edge_edge_pairs();
+        tbb::enumerable_thread_specific<std::vector<int>> local;
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, vt.size() + ee.size(), PAIRS_PER_TASK),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t i = range.begin(); i < range.end(); ++i) {
+                    std::array<int, 4> v;
+                    if (i < vt.size()) {
+                        const Triangle& t = mesh.triangle(vt[i].ti);
+                        v = {vt[i].vi, t[0], t[1], t[2]};
+                    } else {
+                        const Edge& a = mesh.edge(ee[i - vt.size()].ei);
+                        const Edge& b = mesh.edge(ee[i - vt.size()].ej);
+                        v = {a[0], a[1], b[0], b[1]};
+                    }
+                    if (!(moving(v[0]) || moving(v[1]) || moving(v[2]) || moving(v[3])))
+                        continue;
+                    const auto p0 = [&](int k) -> const Vec3& {
+                        return x_t0[static_cast<size_t>(v[k])];
+                    };
+                    const auto p1 = [&](int k) -> const Vec3& {
+                        return x_t1[static_cast<size_t>(v[k])];
+                    };
+                    const bool collides =
+                        i < vt.size()
+                            ? point_triangle_ccd(p0(0), p0(1), p0(2), p0(3), p1(0), p1(1),
+                                                 p1(2), p1(3))
+                            : edge_edge_ccd(p0(0), p0(1), p0(2), p0(3), p1(0), p1(1), p1(2),
+                                            p1(3));
+                    if (collides)
+                        local.local().insert(local.local().end(), v.begin(), v.end());
+                }
+            });
+        int held = 0;
+        for (const std::vector<int>& part : local)
+            for (int vi : part)
+                if (moving(vi)) {
+                    x_t1[static_cast<size_t>(vi)] = x_t0[static_cast<size_t>(vi)];
+                    ++held;
+                }
+        report.held_colliding += held;
+        if (held == 0)
+            return;
+    }
 }
 
 }  // namespace
@@ -140,19 +203,8 @@ SmoothReport smooth_null_space(SurfaceMesh& mesh, const RemeshOptions& options,
             report.vertices_moved += displacement[vi].squaredNorm() > 0.0 ? 1 : 0;
         }
         ++report.iterations;
-        if (context.collision_safety) {
-            // Collision response must not move the open boundary either (§4.4).
-            std::vector<std::uint8_t> pinned(x_t0.size(), 0);
-            for (int vi = 0; vi < mesh.num_vertices(); ++vi)
-                pinned[static_cast<size_t>(vi)] =
-                    mesh.vertex_alive(vi) && mesh.is_boundary_vertex(vi) ? 1 : 0;
-            report.collisions = resolve_collisions(mesh, x_t0, x_t1, PSEUDO_STEP_DURATION,
-                                                   context.collision, nullptr, &pinned);
-            if (!report.collisions.collision_free) {
-                ++report.refused_collision;
-                continue;
-            }
-        }
+        if (context.collision_safety)
+            hold_colliding_vertices(mesh, x_t0, x_t1, report);
         mesh.set_positions(x_t1);
     }
     report.seconds =
