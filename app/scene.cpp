@@ -293,6 +293,10 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
     v.boolean("smoothing_onto_fitted_surface", o.smoothing_onto_fitted_surface,
               "smoothing moves smooth vertices along a fitted quadratic surface instead of "
               "volume-neutrally in the tangent plane (more accurate shape; not volume-neutral)");
+    v.boolean("smoothing_holds_colliding_vertices", o.smoothing_holds_colliding_vertices,
+              "with collision safety, a smoothing move that may collide keeps its vertices in "
+              "place instead of pushing the other sheet away (keeps the volume of thin folded "
+              "sheets)");
 }
 
 template <typename V>

@@ -19,6 +19,8 @@ namespace meniscus::tracker {
 
 namespace {
 
+/// The smoothing pseudo-trajectory lasts one unit of pseudo-time (only displacements matter).
+constexpr double PSEUDO_STEP_DURATION = 1.0;
 /// Grain of the parallel loop over vertices.
 constexpr int VERTICES_PER_TASK = 256;
 /// Grain of the parallel CCD loop over candidate pairs.
@@ -203,8 +205,21 @@ SmoothReport smooth_null_space(SurfaceMesh& mesh, const RemeshOptions& options,
             report.vertices_moved += displacement[vi].squaredNorm() > 0.0 ? 1 : 0;
         }
         ++report.iterations;
-        if (context.collision_safety)
+        if (context.collision_safety && options.smoothing_holds_colliding_vertices) {
             hold_colliding_vertices(mesh, x_t0, x_t1, report);
+        } else if (context.collision_safety) {
+            // Collision response must not move the open boundary either (§4.4).
+            std::vector<std::uint8_t> pinned(x_t0.size(), 0);
+            for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+                pinned[static_cast<size_t>(vi)] =
+                    mesh.vertex_alive(vi) && mesh.is_boundary_vertex(vi) ? 1 : 0;
+            report.collisions = resolve_collisions(mesh, x_t0, x_t1, PSEUDO_STEP_DURATION,
+                                                   context.collision, nullptr, &pinned);
+            if (!report.collisions.collision_free) {
+                ++report.refused_collision;
+                continue;
+            }
+        }
         mesh.set_positions(x_t1);
     }
     report.seconds =

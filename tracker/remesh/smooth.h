@@ -3,14 +3,16 @@
 /// area-weighted centroid of its incident triangles, but only within the null space of its
 /// quadric metric tensor — the tangent plane on a smooth patch, the ridge line on a ridge, not
 /// at all at a corner — so volume and features are kept to first order. The whole smoothing
-/// step is a pseudo-trajectory of all vertices; with collision safety, every vertex of a pair
-/// that may collide during it (exact CCD) is held still, and the check repeats until none may.
-/// Smoothing is not a physical motion, so nothing is pushed: resolve_collisions' impulses and
-/// impact zones moved the neighbouring sheets apart instead, and on the A4 curl-noise test
-/// (thin sheets folded against each other) that added 0.35 % volume by t = 9.5 and 1.9 % by
-/// t = 15.5, while the smoothing moves themselves changed it by 0.03 %. Vertices on an open
+/// step is a pseudo-trajectory of all vertices. With collision safety it goes through
+/// resolve_collisions (§3.8), or, with options.smoothing_holds_colliding_vertices, every vertex
+/// of a pair that may collide during it (exact CCD) is held still, repeated until none may:
+/// smoothing is not a physical motion, and resolve_collisions' impulses and impact zones move
+/// the neighbouring sheets apart (on the A4 curl-noise test, thin sheets folded against each
+/// other, that added 0.35 % volume by t = 9.5 and 1.9 % by t = 15.5, while the smoothing moves
+/// themselves changed it by 0.03 %). Vertices on an open
 /// boundary do not move (§4.4).
 
+#include "tracker/collision_resolution.h"
 #include "tracker/mesh.h"
 #include "tracker/remesh_options.h"
 
@@ -25,10 +27,14 @@ struct SmoothReport {
     int ridge_vertices = 0;     ///< moved along a ridge line (last iteration)
     int corner_vertices = 0;    ///< kept still as corners (last iteration)
     int boundary_vertices = 0;  ///< kept still on the open boundary (last iteration)
-    /// Vertices held still because their move could collide (summed over iterations; with
-    /// collision safety only).
+    /// Collision resolution of the last iteration (default-constructed when safety is off or
+    /// smoothing_holds_colliding_vertices is on).
+    CollisionReport collisions;
+    /// Iterations whose pseudo-trajectory could not be made collision-free (motion dropped).
+    int refused_collision = 0;
+    /// With smoothing_holds_colliding_vertices: vertices held still because their move could
+    /// collide, and rounds of collision checks (both summed over iterations).
     int held_colliding = 0;
-    /// Rounds of collision checks (summed over iterations; with collision safety only).
     int collision_rounds = 0;
     double seconds = 0.0;
 };
@@ -47,8 +53,9 @@ Vec3 vertex_volume_gradient(const SurfaceMesh& mesh, int vi);
 std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const RemeshOptions& options,
                                            SmoothReport* counts = nullptr);
 
-/// Runs options.smoothing_iterations smoothing steps. With collision safety, vertices whose
-/// move may collide are held still (see the file comment); the mesh stays intersection-free.
+/// Runs options.smoothing_iterations smoothing steps. With collision safety the mesh stays
+/// intersection-free: the motion of each step goes through resolve_collisions(context.collision)
+/// with unit duration, or colliding vertices are held (see the file comment).
 SmoothReport smooth_null_space(SurfaceMesh& mesh, const RemeshOptions& options,
                                const ImproveContext& context);
 
