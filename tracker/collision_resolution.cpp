@@ -413,9 +413,7 @@ private:
                 active.push_back(r);
         }
         std::vector<std::uint8_t> in_active(rows.size(), 0);
-        std::vector<Vec3> trial;
-        bool have_solution = false;
-        std::vector<Vec3> solution;
+        std::vector<Vec3> trial;  // the last correction with every λ ≥ 0; empty: none yet
         for (int round = 0; round < MAX_ACTIVE_SET_ROUNDS && !active.empty(); ++round) {
             Eigen::VectorXd lambda;
             if (!solve_equalities(constraints, rows, active, d, lambda))
@@ -437,8 +435,6 @@ private:
                     trial[v] += (li * c.weights[k] * m_inv_mass[v]) * c.normal;
                 }
             }
-            solution = trial;
-            have_solution = true;
             std::fill(in_active.begin(), in_active.end(), 0);
             for (int r : active)
                 in_active[static_cast<size_t>(r)] = 1;
@@ -451,8 +447,8 @@ private:
             if (!joined)
                 break;
         }
-        if (have_solution)
-            d = std::move(solution);
+        if (!trial.empty())
+            d = std::move(trial);
     }
 
     /// λ of the rows `active` (indices into `rows`) held as equalities: A = C M⁻¹ Cᵀ assembled
