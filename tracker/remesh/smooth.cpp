@@ -49,11 +49,13 @@ void hold_colliding_vertices(const SurfaceMesh& mesh, const std::vector<Vec3>& x
     const auto moving = [&](int v) {
         return x_t1[static_cast<size_t>(v)] != x_t0[static_cast<size_t>(v)];
     };
+    // Holding a vertex shrinks its swept box to a point inside it, so the first round's
+    // candidate pairs contain every later round's: the broad phase is built once.
+    const BroadPhase broad(mesh, x_t0, x_t1, 0.0);
+    const std::vector<VertexTrianglePair> vt = broad.vertex_triangle_pairs();
+    const std::vector<EdgeEdgePair> ee = broad.edge_edge_pairs();
     for (;;) {
         ++report.collision_rounds;
-        const BroadPhase broad(mesh, x_t0, x_t1, 0.0);
-        const std::vector<VertexTrianglePair> vt = broad.vertex_triangle_pairs();
-        const std::vector<EdgeEdgePair> ee = broad.edge_edge_pairs();
         tbb::enumerable_thread_specific<std::vector<int>> local;
         tbb::parallel_for(
             tbb::blocked_range<size_t>(0, vt.size() + ee.size(), PAIRS_PER_TASK),
