@@ -8,6 +8,8 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <type_traits>
 #include <vector>
 
 namespace meniscus::tracker {
@@ -257,12 +259,13 @@ int choose_split(const Box& box, const std::array<std::array<double, 3>, NUM_COR
 /// best contact found so far, so that toi_lower is the start of the earliest such box (up to
 /// the budget; when the budget runs out, the earliest start among the boxes left is returned,
 /// which is still a lower bound).
-SearchResult search(const GapFunction& f, const CcdOptions& options, bool earliest) {
+SearchResult search(const GapFunction& f, const CcdOptions& options, bool earliest,
+                    double t_begin = 0.0, double t_end = 1.0) {
     SearchResult result;
     if (!f.finite) {
         result.may_collide = true;
         result.inconclusive = true;
-        result.toi_lower = 0.0;
+        result.toi_lower = t_begin;
         return result;
     }
     constexpr double NO_CONTACT = std::numeric_limits<double>::infinity();
@@ -279,7 +282,7 @@ SearchResult search(const GapFunction& f, const CcdOptions& options, bool earlie
     };
     std::vector<Box> stack;
     stack.reserve(INITIAL_STACK_CAPACITY);
-    stack.push_back(Box{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 0});
+    stack.push_back(Box{{t_begin, 0.0, 0.0}, {t_end, 1.0, 1.0}, 0});
     std::array<std::array<double, 3>, NUM_CORNERS> values{};
     while (!stack.empty()) {
         const Box box = stack.back();
@@ -393,7 +396,7 @@ void require_finite(std::initializer_list<const Eigen::Vector3d*> points, const 
 template <size_t N, size_t M>
 bool hulls_separated(const std::array<const Eigen::Vector3d*, N>& first,
                      const std::array<const Eigen::Vector3d*, M>& second,
-                     std::initializer_list<Eigen::Vector3d> axes) {
+                     std::initializer_list<Eigen::Vector3d> axes, double position_error = 0.0) {
     double coordinate_bound = 0.0;
     for (const Eigen::Vector3d* p : first)
         coordinate_bound = std::max(coordinate_bound, p->cwiseAbs().maxCoeff());
@@ -404,7 +407,7 @@ bool hulls_separated(const std::array<const Eigen::Vector3d*, N>& first,
             continue;
         const double margin = HULL_ROUNDING_FACTOR * std::numeric_limits<double>::epsilon() *
                                   n.cwiseAbs().sum() * coordinate_bound +
-                              UNDERFLOW_ALLOWANCE;
+                              2.0 * n.cwiseAbs().sum() * position_error + UNDERFLOW_ALLOWANCE;
         double lo1 = std::numeric_limits<double>::infinity(), hi1 = -lo1, lo2 = lo1, hi2 = -lo1;
         for (const Eigen::Vector3d* p : first) {
             const double s = n.dot(*p);
@@ -420,6 +423,91 @@ bool hulls_separated(const std::array<const Eigen::Vector3d*, N>& first,
             return true;
     }
     return false;
+}
+
+/// Time intervals of the step cleared by hulls_separated are halved at most this many times
+/// (at most 2^7 - 1 interval tests, two proximity queries each).
+constexpr int MAX_TIME_SPLIT_DEPTH = 6;
+/// Rounding of one interpolated coordinate x0 + t (x1 - x0), in units of the machine epsilon
+/// times max |x| (about 5u; taken as 8u).
+constexpr double LERP_ERROR_FACTOR = 4.0;
+
+/// The part [begin, end] of the step that uncleared_time_range could not clear; empty when
+/// begin > end.
+struct TimeRange {
+    double begin = 1.0;
+    double end = 0.0;
+    bool empty() const { return begin > end; }
+};
+
+/// Clears what it can of the step [0, 1] by separating hulls on time intervals. Near misses
+/// that the parameter-box search resolves only with a huge number of boxes (a point passing
+/// along a sliver triangle, nearly parallel edges a tiny distance apart for the whole step)
+/// are apart on short intervals along the direction of their closest points: on [ta, tb]
+/// each primitive stays in the convex hull of its positions at ta and tb, and hulls_separated
+/// is sound for any axis. `axes(first, second)` gives the axes of the primitives at one time
+/// (closest-point direction, face normal or edge cross product). Interpolated positions err
+/// by at most LERP_ERROR_FACTOR · ε · max|x| per coordinate, which the margin covers. Interval
+/// ends are dyadic, so the box search over what remains keeps exact corners.
+template <std::size_t N, std::size_t M, typename Axes>
+TimeRange uncleared_time_range(const std::array<const Eigen::Vector3d*, N>& first_t0,
+                               const std::array<const Eigen::Vector3d*, N>& first_t1,
+                               const std::array<const Eigen::Vector3d*, M>& second_t0,
+                               const std::array<const Eigen::Vector3d*, M>& second_t1,
+                               const Axes& axes) {
+    double coordinate_bound = 0.0;
+    for (const auto* group : {&first_t0, &first_t1})
+        for (const Eigen::Vector3d* p : *group)
+            coordinate_bound = std::max(coordinate_bound, p->cwiseAbs().maxCoeff());
+    for (const auto* group : {&second_t0, &second_t1})
+        for (const Eigen::Vector3d* p : *group)
+            coordinate_bound = std::max(coordinate_bound, p->cwiseAbs().maxCoeff());
+    const double position_error =
+        LERP_ERROR_FACTOR * std::numeric_limits<double>::epsilon() * coordinate_bound;
+    auto at = [](const auto& x0, const auto& x1, double t) {
+        std::array<Eigen::Vector3d, std::tuple_size<std::decay_t<decltype(x0)>>::value> x;
+        for (std::size_t i = 0; i < x.size(); ++i)
+            x[i] = *x0[i] + t * (*x1[i] - *x0[i]);
+        return x;
+    };
+    struct Interval {
+        double begin, end;
+        int depth;
+    };
+    TimeRange uncleared;
+    std::vector<Interval> stack{{0.0, 1.0, 0}};
+    while (!stack.empty()) {
+        const Interval in = stack.back();
+        stack.pop_back();
+        const auto first_a = at(first_t0, first_t1, in.begin);
+        const auto first_b = at(first_t0, first_t1, in.end);
+        const auto second_a = at(second_t0, second_t1, in.begin);
+        const auto second_b = at(second_t0, second_t1, in.end);
+        std::array<const Eigen::Vector3d*, 2 * N> first{};
+        std::array<const Eigen::Vector3d*, 2 * M> second{};
+        for (std::size_t i = 0; i < N; ++i) {
+            first[i] = &first_a[i];
+            first[N + i] = &first_b[i];
+        }
+        for (std::size_t i = 0; i < M; ++i) {
+            second[i] = &second_a[i];
+            second[M + i] = &second_b[i];
+        }
+        const auto axes_a = axes(first_a, second_a);
+        const auto axes_b = axes(first_b, second_b);
+        if (hulls_separated<2 * N, 2 * M>(first, second, {axes_a[0], axes_a[1], axes_b[0], axes_b[1]},
+                                          position_error))
+            continue;
+        if (in.depth == MAX_TIME_SPLIT_DEPTH) {
+            uncleared.begin = std::min(uncleared.begin, in.begin);
+            uncleared.end = std::max(uncleared.end, in.end);
+            continue;
+        }
+        const double mid = 0.5 * (in.begin + in.end);
+        stack.push_back({mid, in.end, in.depth + 1});
+        stack.push_back({in.begin, mid, in.depth + 1});
+    }
+    return uncleared;
 }
 
 SearchResult point_triangle_search(const Eigen::Vector3d& p_t0, const Eigen::Vector3d& a_t0,
@@ -447,9 +535,19 @@ SearchResult point_triangle_search(const Eigen::Vector3d& p_t0, const Eigen::Vec
             return SearchResult{};
         }
     }
+    const TimeRange range = uncleared_time_range<1, 3>(
+        {&p_t0}, {&p_t1}, {&a0, &b0, &c0}, {&a1, &b1, &c1},
+        [](const std::array<Eigen::Vector3d, 1>& p, const std::array<Eigen::Vector3d, 3>& t) {
+            return std::array<Eigen::Vector3d, 2>{
+                point_triangle_proximity(p[0], t[0], t[1], t[2]).normal,
+                (t[1] - t[0]).cross(t[2] - t[0])};
+        });
+    if (range.empty()) {
+        return SearchResult{};
+    }
     const GapFunction f = make_gap_function({p_t0 - a0, b0 - a0, c0 - a0},
                                             {p_t1 - a1, b1 - a1, c1 - a1}, true, options);
-    return search(f, options, earliest);
+    return search(f, options, earliest, range.begin, range.end);
 }
 
 SearchResult edge_edge_search(const Eigen::Vector3d& ea0_t0, const Eigen::Vector3d& ea1_t0,
@@ -498,9 +596,18 @@ SearchResult edge_edge_search(const Eigen::Vector3d& ea0_t0, const Eigen::Vector
     }
     // F = (ea0 - eb0) - u (ea0 - ea1) - v (eb1 - eb0) = [ea0 + u (ea1 - ea0)] - [eb0 + v (eb1 -
     // eb0)]
+    const TimeRange range = uncleared_time_range<2, 2>(
+        {&a0, &a1}, {&a0e, &a1e}, {&b0, &b1}, {&b0e, &b1e},
+        [](const std::array<Eigen::Vector3d, 2>& a, const std::array<Eigen::Vector3d, 2>& b) {
+            return std::array<Eigen::Vector3d, 2>{edge_edge_proximity(a[0], a[1], b[0], b[1]).normal,
+                                                  (a[1] - a[0]).cross(b[1] - b[0])};
+        });
+    if (range.empty()) {
+        return SearchResult{};
+    }
     const GapFunction f = make_gap_function({a0 - b0, a0 - a1, b1 - b0},
                                             {a0e - b0e, a0e - a1e, b1e - b0e}, false, options);
-    return search(f, options, earliest);
+    return search(f, options, earliest, range.begin, range.end);
 }
 
 Eigen::Vector3d lerp(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, double t) {

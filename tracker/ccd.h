@@ -17,6 +17,13 @@
 /// q = a + u (b - a) + v (1 - u) (c - a), (u, v) in [0, 1]^2, which covers exactly the triangle.
 /// Vertices are put in a canonical order first, so the result does not depend on the order of
 /// the triangle's vertices, of an edge's endpoints, or of the two edges.
+///
+/// Before the search, the step is cleared where a plane separates the two primitives' convex
+/// hulls: first over the whole step, then on dyadic time intervals (down to 1/64) along the
+/// closest-point direction at their ends. This settles the near misses the box search can only
+/// settle with a huge number of boxes (a point passing along a sliver triangle, nearly parallel
+/// edges a tiny distance apart for the whole step); the search then covers only the time range
+/// left uncleared.
 
 #include <Eigen/Core>
 

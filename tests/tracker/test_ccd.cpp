@@ -608,6 +608,48 @@ TEST(CcdFalsePositives, NearlyCollinearEdgesReported) {
     }
 }
 
+// Regression (A1 vertex-normal motion with capped split offsets): near misses that stay a tiny
+// distance apart for the whole step — a point passing along a sliver triangle whose vertices are
+// nearly collinear, edges nearly parallel 1.5e-5 apart — exhausted the 20 000-box budget and
+// answered "may collide"; thousands of them per step stalled remeshing and collision
+// resolution for minutes. Separating hulls on short time intervals along the closest-point
+// direction now clears them without any box.
+TEST(CcdFalsePositives, PersistentNearMissesAreClearedWithoutTheBoxSearch) {
+    const Query sliver{{Vector3d{-0.017972649451705784, 0.015621342099921812, -0.22393541726556412},
+                        Vector3d{-0.050859506242790842, 0.03219243931599293, -0.20594765903752363},
+                        Vector3d{-0.018463799381058868, 0.015889832090012546, -0.2236787694633528},
+                        Vector3d{0.045836464413051996, -0.016446892371857487, -0.2588843425127999}},
+                       {Vector3d{-0.016008049734293438, 0.014547382139558883, -0.22496200847440934},
+                        Vector3d{-0.050859506242790842, 0.03219243931599293, -0.20594765903752363},
+                        Vector3d{-0.018463799381058868, 0.015889832090012546, -0.2236787694633528},
+                        Vector3d{0.045836464413051996, -0.016446892371857487, -0.2588843425127999}}};
+    const Query parallel{
+        {Vector3d{0.045568515653215437, -0.016288297558888117, -0.25899425772613976},
+         Vector3d{-0.018194026975519556, 0.015873159132424115, -0.22391237990961299},
+         Vector3d{-0.019486147325523298, 0.016492619166721154, -0.22322407473240341},
+         Vector3d{0.013041184163846069, 0.00010216080391651887, -0.24110916622927159}},
+        {Vector3d{0.045568515653215437, -0.016288297558888117, -0.25899425772613976},
+         Vector3d{-0.01766263004570244, 0.01557783975926871, -0.22418879628845179},
+         Vector3d{-0.019486147325523298, 0.016492619166721154, -0.22322407473240341},
+         Vector3d{0.013041184163846069, 0.00010216080391651887, -0.24110916622927159}}};
+    ASSERT_EQ(oracle::certify_point_triangle_miss(sliver.x0, sliver.x1),
+              oracle::Certificate::no_collision);
+    ASSERT_EQ(oracle::certify_edge_edge_miss(parallel.x0, parallel.x1),
+              oracle::Certificate::no_collision);
+    EXPECT_FALSE(pt(sliver));
+    EXPECT_FALSE(ee(parallel));
+    const CcdResult s = point_triangle_ccd_detailed(sliver.x0[0], sliver.x0[1], sliver.x0[2],
+                                                    sliver.x0[3], sliver.x1[0], sliver.x1[1],
+                                                    sliver.x1[2], sliver.x1[3]);
+    const CcdResult e = edge_edge_ccd_detailed(parallel.x0[0], parallel.x0[1], parallel.x0[2],
+                                               parallel.x0[3], parallel.x1[0], parallel.x1[1],
+                                               parallel.x1[2], parallel.x1[3]);
+    EXPECT_FALSE(s.may_collide);
+    EXPECT_FALSE(e.may_collide);
+    EXPECT_LT(s.boxes_checked, 100);
+    EXPECT_LT(e.boxes_checked, 100);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Detailed variants.
 
