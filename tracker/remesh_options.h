@@ -19,7 +19,7 @@ struct RemeshOptions {
 
     double max_edge_fraction = 1.5;           ///< α / ξ: edges longer than α are split, > min
     double min_edge_fraction = 0.5;           ///< β / ξ: edges shorter than β collapse, > 0
-    double max_volume_change_fraction = 0.1;  ///< γ / ξ³ per flip or collapse, > 0
+    double max_volume_change_fraction = 0.1;  ///< γ / ξ³ per flip, collapse or split, > 0
 
     int max_split_passes = 4;     ///< sweeps over long edges per improvement, ≥ 1
     /// New split vertices go onto a quadratic height field fitted over both endpoints' one-rings

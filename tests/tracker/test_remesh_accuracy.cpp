@@ -13,6 +13,7 @@
 #include "tracker/remesh/collapse.h"
 #include "tracker/remesh/flip.h"
 #include "tracker/remesh/smooth.h"
+#include "tracker/remesh/split.h"
 
 #include <gtest/gtest.h>
 
@@ -123,6 +124,33 @@ TEST(RemeshAccuracy, SmoothingAmongTouchingSheetsHoldsCollidingVerticesAndPushes
     EXPECT_TRUE(find_self_intersections(mesh).triangle_pairs.empty());
     // Each move keeps the volume to first order; all together change it by second-order terms.
     EXPECT_LT(std::abs(relative_volume_change(before, mesh)), 1e-5);
+}
+
+// Regression (A4 curl noise): at folds much thinner than an edge the butterfly stencil reaches
+// across the fold and its point lands far off the midpoint; those splits added 1 % volume by
+// t = 9.5. The offset is now scaled back so that no split changes the volume by more than γ.
+TEST(RemeshAccuracy, SplitsAtThinFoldsChangeTheVolumeByAtMostGammaEach) {
+    SurfaceMesh mesh = to_surface_mesh(
+        read_ply(std::string(MENISCUS_TEST_DATA_DIR) + "/regression/curl_noise_a4_t28.1.ply"),
+        "curl_noise_a4_t28.1.ply");
+    const double volume = enclosed_volume(mesh);
+    RemeshOptions options;
+    options.max_edge_fraction = 1.0;  // the run's α is 1.5 ξ: make it split a few thousand edges
+    options.min_edge_fraction = 0.4;
+    options.max_volume_change_fraction = 5e-4;  // the A4 run's γ / ξ³
+    options.max_split_passes = 1;
+    ImproveContext context;
+    context.xi = 0.040977574596089125;
+    context.collision_safety = true;
+    const SplitReport r = split_long_edges(mesh, options, context);
+    const double gamma = remesh_limits(options, context.xi).max_volume_change;
+    EXPECT_GT(r.splits, 1000);
+    EXPECT_GT(r.volume_limited, 0);
+    EXPECT_LT(r.volume_limited, r.splits);
+    // A split at the midpoint keeps the volume exactly; only the offset changes it.
+    EXPECT_LE(std::abs(enclosed_volume(mesh) - volume), r.splits * gamma * (1 + 1e-9));
+    EXPECT_TRUE(find_self_intersections(mesh).triangle_pairs.empty());
+    EXPECT_TRUE(validate_mesh(mesh).empty());
 }
 
 TEST(RemeshAccuracy, CollapsingEdgesOfASphereKeepsItsVolume) {

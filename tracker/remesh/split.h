@@ -19,6 +19,7 @@ struct SplitReport {
     int arc = 0;                    ///< of those, aimed at the circular-arc point (surface_fit.h)
     int butterfly_collides = 0;     ///< of those, kept at the midpoint: butterfly motion collided
     int butterfly_unavailable = 0;  ///< of those, at the midpoint: no butterfly stencil
+    int volume_limited = 0;  ///< of those, offset from the midpoint scaled back to change the volume by γ
     int skipped_boundary = 0;       ///< long boundary edges left alone (§4.4)
     int skipped_nonmanifold = 0;    ///< long non-manifold edges left alone
     int passes = 0;                 ///< sweeps over the long edges
