@@ -17,6 +17,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 
 namespace meniscus::tracker {
@@ -133,6 +134,7 @@ public:
     int repel(std::vector<Vec3>& d) {
         const double padding = 0.5 * m_o.proximity_epsilon;
         m_candidates = build_candidates(d, padding + CANDIDATE_SLACK_FRACTION * m_o.proximity_epsilon);
+        m_detected_d.clear();
         std::vector<Contact> contacts;
         for (const VertexTrianglePair& p : m_candidates.vertex_triangle) {
             const Triangle& t = m_mesh.triangle(p.ti);
@@ -169,10 +171,20 @@ public:
         std::vector<Vec3> x1(m_x0.size());
         for (size_t i = 0; i < x1.size(); ++i)
             x1[i] = m_x0[i] + d[i];
-        if (!covers(m_candidates, d))
+        if (!covers(m_candidates, d)) {
             m_candidates = build_candidates(d, CANDIDATE_SLACK_FRACTION * m_o.proximity_epsilon);
-        const std::vector<VertexTrianglePair> vt = filter_vertex_triangle(x1);
-        const std::vector<EdgeEdgePair> ee = filter_edge_edge(x1);
+            m_detected_d.clear();
+        }
+        // Only pairs with a vertex whose displacement changed since the last call are tested;
+        // the others keep their last answer (a CCD answer depends on x0 and x1 alone).
+        std::vector<std::uint8_t> changed;  // empty: every pair is tested
+        if (m_detected_d.size() == d.size()) {
+            changed.resize(d.size());
+            for (size_t i = 0; i < d.size(); ++i)
+                changed[i] = d[i] != m_detected_d[i] ? 1 : 0;
+        }
+        const std::vector<VertexTrianglePair> vt = filter_vertex_triangle(x1, changed);
+        const std::vector<EdgeEdgePair> ee = filter_edge_edge(x1, changed);
         tbb::enumerable_thread_specific<std::vector<Contact>> local;
         const double target = IMPULSE_SEPARATION_FRACTION * m_o.proximity_epsilon;
         tbb::parallel_for(tbb::blocked_range<size_t>(0, vt.size() + ee.size(), PARALLEL_GRAIN),
@@ -196,9 +208,16 @@ public:
         std::vector<Contact> all;
         for (auto& part : local)
             all.insert(all.end(), part.begin(), part.end());
-        // Deterministic order regardless of threading.
-        std::sort(all.begin(), all.end(),
-                  [](const Contact& a, const Contact& b) { return a.vertices < b.vertices; });
+        if (!changed.empty())
+            for (const Contact& c : m_detected)
+                if (!any_changed(changed, c.vertices))
+                    all.push_back(c);
+        // Deterministic order regardless of threading and of which answers were kept.
+        std::sort(all.begin(), all.end(), [](const Contact& a, const Contact& b) {
+            return std::tie(a.vertices, a.edge_edge) < std::tie(b.vertices, b.edge_edge);
+        });
+        m_detected_d = d;
+        m_detected = all;
         return all;
     }
 
@@ -305,23 +324,35 @@ private:
                (b.min().array() <= a.max().array()).all();
     }
 
-    /// The candidates whose unpadded swept boxes overlap: exactly what BroadPhase(x0, x1, 0)
-    /// returns, in the same (sorted) order.
-    std::vector<VertexTrianglePair> filter_vertex_triangle(const std::vector<Vec3>& x1) const {
+    static bool any_changed(const std::vector<std::uint8_t>& changed,
+                            const std::array<int, 4>& v) {
+        return changed.empty() || changed[static_cast<size_t>(v[0])] ||
+               changed[static_cast<size_t>(v[1])] || changed[static_cast<size_t>(v[2])] ||
+               changed[static_cast<size_t>(v[3])];
+    }
+
+    /// The candidates with a changed vertex (all when `changed` is empty) whose unpadded swept
+    /// boxes overlap: with every vertex changed, exactly what BroadPhase(x0, x1, 0) returns, in
+    /// the same (sorted) order.
+    std::vector<VertexTrianglePair> filter_vertex_triangle(
+        const std::vector<Vec3>& x1, const std::vector<std::uint8_t>& changed) const {
         std::vector<VertexTrianglePair> out;
         for (const VertexTrianglePair& p : m_candidates.vertex_triangle) {
             const Triangle& t = m_mesh.triangle(p.ti);
-            if (boxes_overlap(moving_box({p.vi}, x1), moving_box({t[0], t[1], t[2]}, x1)))
+            if (any_changed(changed, {p.vi, t[0], t[1], t[2]}) &&
+                boxes_overlap(moving_box({p.vi}, x1), moving_box({t[0], t[1], t[2]}, x1)))
                 out.push_back(p);
         }
         return out;
     }
-    std::vector<EdgeEdgePair> filter_edge_edge(const std::vector<Vec3>& x1) const {
+    std::vector<EdgeEdgePair> filter_edge_edge(const std::vector<Vec3>& x1,
+                                               const std::vector<std::uint8_t>& changed) const {
         std::vector<EdgeEdgePair> out;
         for (const EdgeEdgePair& p : m_candidates.edge_edge) {
             const Edge& a = m_mesh.edge(p.ei);
             const Edge& b = m_mesh.edge(p.ej);
-            if (boxes_overlap(moving_box({a[0], a[1]}, x1), moving_box({b[0], b[1]}, x1)))
+            if (any_changed(changed, {a[0], a[1], b[0], b[1]}) &&
+                boxes_overlap(moving_box({a[0], a[1]}, x1), moving_box({b[0], b[1]}, x1)))
                 out.push_back(p);
         }
         return out;
@@ -566,6 +597,9 @@ private:
     const CollisionOptions& m_o;
     std::vector<double> m_inv_mass;
     Candidates m_candidates;
+    /// detect()'s last displacements and contacts, on the current candidates (empty: none).
+    std::vector<Vec3> m_detected_d;
+    std::vector<Contact> m_detected;
 };
 
 }  // namespace
