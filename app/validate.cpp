@@ -630,7 +630,6 @@ void case_a4(Context& c) {
         s.tracker = paper_tracker_options();
         s.tracker.allow_topology_changes = false;
         s.tracker.remesh.max_volume_change_fraction = CURL_VOLUME_FRACTION;
-        s.tracker.remesh.smoothing_holds_colliding_vertices = true;  // thin folded sheets
         s.tracker.collision_safety = safety;
         s.stepper = std::shared_ptr<const tracker::FlowStepper>(holder, &holder->stepper);
         s.t_end = safety ? CURL_END : CURL_UNSAFE_END;
