@@ -49,6 +49,16 @@ constexpr double CANDIDATE_SLACK_SAFETY = 0.5;
 /// Box corners are rounded sums of coordinates; the slack must dwarf their rounding error
 /// (this many units in the last place of the largest coordinate) or the candidates are rebuilt.
 constexpr double CANDIDATE_ROUNDING_ULPS = 64.0;
+/// When the candidates no longer cover the displacements (impulses and impact zones moved a
+/// vertex by more than the slack allows), the new slack is this many times that move: later
+/// corrections are usually no larger, and each rebuild is a broad phase over the whole mesh
+/// (A4 at 50k triangles rebuilt 4–6 times per step with the fixed slack).
+constexpr double CANDIDATE_SLACK_GROWTH = 4.0;
+/// ... but at most this fraction of the largest displacement coordinate (a shortened step or a
+/// rigid zone moves vertices by a large share of their motion) and of the mean edge length:
+/// boxes padded by more would pair far too many elements.
+constexpr double CANDIDATE_SLACK_CAP = 0.25;
+constexpr double CANDIDATE_SLACK_EDGE_CAP = 0.05;
 
 /// One possible contact between four vertices with weights ā (Σ āᵢ xᵢ = separation vector) and
 /// a unit normal n: the constraint row is āᵢ nᵀ per vertex.
@@ -124,8 +134,8 @@ struct Candidates {
 class Resolver {
 public:
     Resolver(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0, const CollisionOptions& o,
-             std::vector<double> inv_mass)
-        : m_mesh(mesh), m_x0(x_t0), m_o(o), m_inv_mass(std::move(inv_mass)) {}
+             std::vector<double> inv_mass, CollisionReport* report = nullptr)
+        : m_mesh(mesh), m_x0(x_t0), m_o(o), m_inv_mass(std::move(inv_mass)), m_report(report) {}
 
     /// Phase 1: proximity repulsion at t0 (paper: push apart to ε_p over the step). Builds the
     /// broad phase that the first CCD sweep reuses: swept boxes of the requested motion padded
@@ -172,7 +182,18 @@ public:
         for (size_t i = 0; i < x1.size(); ++i)
             x1[i] = m_x0[i] + d[i];
         if (!covers(m_candidates, d)) {
-            m_candidates = build_candidates(d, CANDIDATE_SLACK_FRACTION * m_o.proximity_epsilon);
+            double moved = 0.0;  // how far the displacements left the last candidates' reference
+            if (m_candidates.d_ref.size() == d.size())
+                for (size_t i = 0; i < d.size(); ++i)
+                    moved = std::max(moved, (d[i] - m_candidates.d_ref[i]).cwiseAbs().maxCoeff());
+            double largest = 0.0;  // largest displacement coordinate: bounds the useful slack
+            for (const Vec3& di : d)
+                largest = std::max(largest, di.cwiseAbs().maxCoeff());
+            const double slack = CANDIDATE_SLACK_FRACTION * m_o.proximity_epsilon;
+            const double grown =
+                std::min({CANDIDATE_SLACK_GROWTH * moved, CANDIDATE_SLACK_CAP * largest,
+                          CANDIDATE_SLACK_EDGE_CAP * mean_edge_length()});
+            m_candidates = build_candidates(d, std::isfinite(grown) ? std::max(slack, grown) : slack);
             m_detected_d.clear();
         }
         // Only pairs with a vertex whose displacement changed since the last call are tested;
@@ -273,7 +294,25 @@ public:
 private:
     const Vec3& x0(int vi) const { return m_x0[static_cast<size_t>(vi)]; }
 
+    /// Mean length of the live edges at t0 (computed once).
+    double mean_edge_length() {
+        if (m_mean_edge_length < 0.0) {
+            double sum = 0.0;
+            int count = 0;
+            for (int ei = 0; ei < m_mesh.num_edges(); ++ei)
+                if (m_mesh.edge_alive(ei)) {
+                    const Edge& e = m_mesh.edge(ei);
+                    sum += (x0(e[1]) - x0(e[0])).norm();
+                    ++count;
+                }
+            m_mean_edge_length = count > 0 ? sum / count : 0.0;
+        }
+        return m_mean_edge_length;
+    }
+
     Candidates build_candidates(const std::vector<Vec3>& d, double padding) const {
+        if (m_report)
+            ++m_report->broad_phases;
         std::vector<Vec3> x1(m_x0.size());
         for (size_t i = 0; i < x1.size(); ++i)
             x1[i] = m_x0[i] + d[i];
@@ -598,6 +637,8 @@ private:
     std::vector<double> m_inv_mass;
     Candidates m_candidates;
     /// detect()'s last displacements and contacts, on the current candidates (empty: none).
+    CollisionReport* m_report = nullptr;  ///< counts broad phases when set
+    double m_mean_edge_length = -1.0;     ///< < 0: not computed yet
     std::vector<Vec3> m_detected_d;
     std::vector<Contact> m_detected;
 };
@@ -631,14 +672,14 @@ CollisionReport resolve_collisions(const SurfaceMesh& mesh, const std::vector<Ve
     if (!(dt > 0.0) || !std::isfinite(dt))
         throw std::invalid_argument("resolve_collisions: dt must be a finite number > 0");
     const std::vector<double> inv = inverse_masses(mesh, masses, pinned);
-    Resolver resolver(mesh, x_t0, options, inv);
+    CollisionReport report;
+    Resolver resolver(mesh, x_t0, options, inv, &report);
 
     // Work with displacements d = x_t1 − x_t0 (velocities times dt).
     std::vector<Vec3> d(n);
     for (size_t i = 0; i < n; ++i)
         d[i] = x_t1[i] - x_t0[i];
     const std::vector<Vec3> requested = d;
-    CollisionReport report;
 
     if (options.repulsion)
         report.proximities = resolver.repel(d);

@@ -42,6 +42,7 @@ struct CollisionReport {
     int largest_impact_zone = 0;  ///< vertices in the largest zone
     int rigid_zone_iterations = 0;
     int step_shortenings = 0;
+    int broad_phases = 0;  ///< candidate-pair sets built (each a broad phase over the mesh)
     /// Fraction of the requested motion actually applied (1 unless step shortening was used;
     /// 0 when every fallback failed and the mesh stayed at x_t0).
     double motion_fraction = 1.0;
