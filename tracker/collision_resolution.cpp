@@ -181,11 +181,8 @@ public:
         std::vector<Vec3> x1(m_x0.size());
         for (size_t i = 0; i < x1.size(); ++i)
             x1[i] = m_x0[i] + d[i];
-        if (!covers(m_candidates, d)) {
-            double moved = 0.0;  // how far the displacements left the last candidates' reference
-            if (m_candidates.d_ref.size() == d.size())
-                for (size_t i = 0; i < d.size(); ++i)
-                    moved = std::max(moved, (d[i] - m_candidates.d_ref[i]).cwiseAbs().maxCoeff());
+        double moved = 0.0;  // how far the displacements left the last candidates' reference
+        if (!covers(m_candidates, d, &moved)) {
             double largest = 0.0;  // largest displacement coordinate: bounds the useful slack
             for (const Vec3& di : d)
                 largest = std::max(largest, di.cwiseAbs().maxCoeff());
@@ -323,7 +320,10 @@ private:
     /// True when every box of the motion x0 → x0 + d (unpadded) lies inside the corresponding
     /// box the candidates were built from: each end position moved by at most half the padding
     /// (the other half absorbs the rounding of the corners, which must be negligible).
-    bool covers(const Candidates& c, const std::vector<Vec3>& d) const {
+    /// `moved_out` (optional) receives max |d − d_ref|∞ (0 when the sizes differ).
+    bool covers(const Candidates& c, const std::vector<Vec3>& d, double* moved_out = nullptr) const {
+        if (moved_out)
+            *moved_out = 0.0;
         if (c.d_ref.size() != d.size() || !(c.padding > 0.0))
             return false;
         double moved = 0.0, coordinate = 0.0;
@@ -333,6 +333,8 @@ private:
                                    (m_x0[i] + d[i]).cwiseAbs().maxCoeff(),
                                    (m_x0[i] + c.d_ref[i]).cwiseAbs().maxCoeff()});
         }
+        if (moved_out)
+            *moved_out = moved;
         const double rounding =
             CANDIDATE_ROUNDING_ULPS * std::numeric_limits<double>::epsilon() * coordinate;
         return std::isfinite(moved) && std::isfinite(coordinate) &&
