@@ -425,6 +425,10 @@ bool hulls_separated(const std::array<const Eigen::Vector3d*, N>& first,
     return false;
 }
 
+Eigen::Vector3d lerp(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, double t) {
+    return x0 + t * (x1 - x0);
+}
+
 /// Time intervals of the step cleared by hulls_separated are halved at most this many times
 /// (at most 2^7 - 1 interval tests, two proximity queries each).
 constexpr int MAX_TIME_SPLIT_DEPTH = 6;
@@ -467,7 +471,7 @@ TimeRange uncleared_time_range(const std::array<const Eigen::Vector3d*, N>& firs
     auto at = [](const auto& x0, const auto& x1, double t) {
         std::array<Eigen::Vector3d, std::tuple_size<std::decay_t<decltype(x0)>>::value> x;
         for (std::size_t i = 0; i < x.size(); ++i)
-            x[i] = *x0[i] + t * (*x1[i] - *x0[i]);
+            x[i] = lerp(*x0[i], *x1[i], t);
         return x;
     };
     struct Interval {
@@ -608,10 +612,6 @@ SearchResult edge_edge_search(const Eigen::Vector3d& ea0_t0, const Eigen::Vector
     const GapFunction f = make_gap_function({a0 - b0, a0 - a1, b1 - b0},
                                             {a0e - b0e, a0e - a1e, b1e - b0e}, false, options);
     return search(f, options, earliest, range.begin, range.end);
-}
-
-Eigen::Vector3d lerp(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, double t) {
-    return x0 + t * (x1 - x0);
 }
 
 Eigen::Vector3d weighted_sum(const std::array<double, 4>& w,
