@@ -38,6 +38,12 @@ Components triangle_components(const SurfaceMesh& mesh);
 /// Signed enclosed volume of each component in `components` (indexed by component id).
 std::vector<double> component_volumes(const SurfaceMesh& mesh, const Components& components);
 
+/// Area-weighted unit vertex normals: for each live vertex the normalized sum of the
+/// (b − a) × (c − a) vectors of its live incident triangles, i.e. unit triangle normals
+/// weighted by twice the triangle area. Dead vertices, vertices without live triangles and
+/// vertices whose weighted sum vanishes get the zero vector. Sized num_vertices().
+std::vector<Vec3> area_weighted_vertex_normals(const SurfaceMesh& mesh);
+
 /// V − E + F over live elements (2 per sphere-like closed component, 0 per torus).
 int euler_characteristic(const SurfaceMesh& mesh);
 

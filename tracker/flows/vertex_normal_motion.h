@@ -8,16 +8,11 @@
 /// A1) its error does not shrink under refinement. Kept for that comparison only.
 
 #include "tracker/mesh.h"
+#include "tracker/mesh_measures.h"  // area_weighted_vertex_normals
 
 #include <vector>
 
 namespace meniscus::tracker {
-
-/// Area-weighted unit vertex normals: for each live vertex the normalized sum of the
-/// (b − a) × (c − a) vectors of its live incident triangles, i.e. unit triangle normals
-/// weighted by twice the triangle area. Dead vertices, vertices without live triangles and
-/// vertices whose weighted sum vanishes get the zero vector. Sized num_vertices().
-std::vector<Vec3> area_weighted_vertex_normals(const SurfaceMesh& mesh);
 
 /// Displacements speed·dt·n_v for each live vertex (n_v from area_weighted_vertex_normals();
 /// zero for dead vertices). `speed` in m/s along the outward normal (positive expands a closed
