@@ -252,6 +252,10 @@ void visit_fields(V& v, tracker::CollisionOptions& o) {
               "", "bound on rigid impact-zone rounds (fallback)");
     v.integer("max_step_shortenings", o.max_step_shortenings, Range::between(0, 60), "",
               "halvings of the motion tried before the mesh is left in place (last fallback)");
+    v.integer("max_zone_matrix_entries", o.max_zone_matrix_entries,
+              Range::between(1, 2'000'000'000), "",
+              "largest impact-zone matrix assembled (entries, 16 bytes each); larger zones move "
+              "rigidly");
 }
 
 template <typename V>

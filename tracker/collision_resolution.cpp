@@ -488,7 +488,7 @@ private:
         std::vector<Vec3> trial;  // the last correction with every λ ≥ 0; empty: none yet
         for (int round = 0; round < MAX_ACTIVE_SET_ROUNDS && !active.empty(); ++round) {
             Eigen::VectorXd lambda;
-            if (!solve_equalities(constraints, rows, active, d, lambda))
+            if (!solve_equalities(constraints, rows, active, d, lambda, report))
                 break;  // left to the rigid-zone fallback
             std::vector<int> kept;
             for (size_t i = 0; i < active.size(); ++i)
@@ -526,10 +526,11 @@ private:
     /// λ of the rows `active` (indices into `rows`) held as equalities: A = C M⁻¹ Cᵀ assembled
     /// sparse — rows r and s couple only through the vertices they share,
     /// A_rs = Σ_v ā_rv ā_sv m_v⁻¹ (n_r · n_s) — and factored by sparse LDLᵀ. False when every
-    /// vertex is pinned or the factorization fails.
+    /// vertex is pinned, the factorization fails or the matrix would exceed
+    /// CollisionOptions::max_zone_matrix_entries.
     bool solve_equalities(const std::vector<Contact>& constraints, const std::vector<int>& rows,
                           const std::vector<int>& active, const std::vector<Vec3>& d,
-                          Eigen::VectorXd& lambda) const {
+                          Eigen::VectorXd& lambda, CollisionReport& report) const {
         const int m = static_cast<int>(active.size());
         // Rows touching each vertex, with the row's weight for it.
         std::vector<std::pair<int, std::pair<int, double>>> touches;  // (vertex, (row, ā))
@@ -542,7 +543,20 @@ private:
             rhs[r] = c.target - relative_normal_displacement(c, d);
         }
         std::sort(touches.begin(), touches.end());
+        size_t entry_count = 0;
+        for (size_t a = 0; a < touches.size();) {
+            size_t b = a;
+            while (b < touches.size() && touches[b].first == touches[a].first)
+                ++b;
+            entry_count += (b - a) * (b - a);
+            a = b;
+        }
+        if (entry_count > static_cast<size_t>(m_o.max_zone_matrix_entries)) {
+            ++report.oversized_zone_solves;
+            return false;  // left to the rigid-zone fallback
+        }
         std::vector<Eigen::Triplet<double>> entries;
+        entries.reserve(entry_count);
         for (size_t a = 0; a < touches.size();) {
             size_t b = a;
             while (b < touches.size() && touches[b].first == touches[a].first)
@@ -658,6 +672,8 @@ void CollisionOptions::validate() const {
         throw std::invalid_argument("max_rigid_zone_iterations: expected an integer >= 0");
     if (max_step_shortenings < 0)
         throw std::invalid_argument("max_step_shortenings: expected an integer >= 0");
+    if (max_zone_matrix_entries < 1)
+        throw std::invalid_argument("max_zone_matrix_entries: expected an integer >= 1");
 }
 
 CollisionReport resolve_collisions(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,

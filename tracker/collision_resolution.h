@@ -29,6 +29,12 @@ struct CollisionOptions {
     int max_impact_zone_iterations = 64;  ///< phase (3) detect/solve rounds, ≥ 1
     int max_rigid_zone_iterations = 16;   ///< phase (4a) rounds, ≥ 0
     int max_step_shortenings = 10;        ///< phase (4b): halvings of the remaining motion, ≥ 0
+    /// Largest C M⁻¹ Cᵀ one impact-zone solve may assemble, in entries before duplicates are
+    /// summed (16 bytes each: 2·10⁷ is 320 MB); ≥ 1. A vertex in k rows of a zone adds k². A
+    /// neck pinching at edges of ξ/16 under mean-curvature flow put thousands of contacts on a
+    /// few vertices, and assembling them asked for more memory than the machine had. A larger
+    /// zone goes to the rigid-zone fallback (CollisionReport::oversized_zone_solves).
+    int max_zone_matrix_entries = 20'000'000;
     void validate() const;                ///< throws std::invalid_argument naming the field
 };
 
@@ -40,6 +46,9 @@ struct CollisionReport {
     int impact_zone_iterations = 0;
     int impact_zones = 0;         ///< zones in the last impact-zone round
     int largest_impact_zone = 0;  ///< vertices in the largest zone
+    /// Impact-zone solves handed to the rigid fallback because their matrix would have
+    /// exceeded CollisionOptions::max_zone_matrix_entries.
+    int oversized_zone_solves = 0;
     int rigid_zone_iterations = 0;
     int step_shortenings = 0;
     int broad_phases = 0;  ///< candidate-pair sets built (each a broad phase over the mesh)

@@ -106,6 +106,35 @@ TEST(CollisionResolution, RejectsBadInput) {
     EXPECT_THROW(resolve_collisions(m, m.positions(), x1, 1.0, o), std::invalid_argument);
 }
 
+/// A zone too large to assemble (CollisionOptions::max_zone_matrix_entries) goes to the rigid
+/// fallback instead of allocating without bound, and the motion is still collision-free.
+TEST(CollisionResolution, OversizedImpactZonesFallBackToRigidMotion) {
+    const SurfaceMesh m =
+        meshed_apart({make_sphere({-0.21, 0, 0}, 0.2), make_sphere({0.21, 0, 0}, 0.2)}, 0.06);
+    std::vector<Vec3> x1 = m.positions();
+    for (Vec3& x : x1)
+        x.x() += x.x() < 0 ? 0.08 : -0.08;  // each sphere pushed 0.06 into the other
+    CollisionOptions o;
+    o.proximity_epsilon = 1e-4;
+    o.impulse_sweeps = 0;  // straight to the impact zones
+    std::vector<Vec3> free_motion = x1;
+    const CollisionReport normal = resolve_collisions(m, m.positions(), free_motion, 1.0, o);
+    ASSERT_GT(normal.impact_zone_iterations, 0) << "the case needs impact zones";
+    EXPECT_EQ(normal.oversized_zone_solves, 0);
+    EXPECT_TRUE(normal.collision_free);
+    EXPECT_TRUE(motion_is_collision_free(m, m.positions(), free_motion));
+
+    o.max_zone_matrix_entries = 1;
+    const CollisionReport capped = resolve_collisions(m, m.positions(), x1, 1.0, o);
+    EXPECT_GT(capped.oversized_zone_solves, 0);
+    EXPECT_GT(capped.rigid_zone_iterations, 0);
+    EXPECT_TRUE(capped.collision_free);
+    EXPECT_TRUE(motion_is_collision_free(m, m.positions(), x1));
+
+    o.max_zone_matrix_entries = 0;
+    EXPECT_THROW(resolve_collisions(m, m.positions(), x1, 1.0, o), std::invalid_argument);
+}
+
 /// Stress: two spheres driven head-on for many steps (no remeshing): they flatten against each
 /// other and never intersect.
 TEST(CollisionStress, SpheresDrivenHeadOn) {
