@@ -13,6 +13,7 @@
 #include "tracker/quadric.h"
 #include "tracker/remesh/butterfly.h"
 #include "tracker/remesh/improve.h"
+#include "tracker/remesh/split.h"
 #include "tracker/topology/change_topology.h"
 
 #include <gtest/gtest.h>
@@ -528,6 +529,40 @@ TEST(RemeshCollisionSafety, NearlyTouchingCubesStayApartUnderRefinementAndCoarse
 TEST(RemeshTestData, DISABLED_Generate) {
     for (const NamedMesh& m : testing::generate_test_meshes())
         write_obj(std::string(MENISCUS_TEST_DATA_DIR) + "/" + m.name + ".obj", m.mesh);
+}
+
+// Regression (A2 dumbbell with curvature-adaptive sizing down to ξ/16, t ≈ 0.0159): a split had
+// left vertex m at the rounded midpoint of a and b; a merge then rebuilt an edge (a, b) on the
+// other sheet. Exactly, m is off that edge (the two sheets do not touch), but splitting the new
+// edge put its rounded midpoint on m itself. Coordinates from that run.
+TEST(RemeshSplit, RefusesAMidpointThatRoundsOntoAnotherSheetsVertex) {
+    const Vec3 a(-0.00083667710424802902, -0.0039387116435465356, 0.0095399635935062583);
+    const Vec3 b(0.00087935508867566898, -0.0071462259964599345, 0.007957798335893513);
+    const Vec3 m(2.1338992213819981e-05, -0.0055424688200032355, 0.0087488809646998865);
+    const Vec3 p(-0.0012101492505732323, -0.0061377380785332799, 0.0084898872815319035);
+    const Vec3 q(0.00016962604618424442, -0.0045237456315205702, 0.0095909874264797391);
+    const Vec3 r(-0.0010639231982105936, -0.0049430935891792357, 0.0088518164617101512);
+    ASSERT_EQ(m, Vec3(0.5 * (a + b)));
+    // Sheet 1: the halves (b, m, p), (m, a, p) of an earlier split. Sheet 2: edge (a, b)
+    // between (b, a, q) and (a, b, r).
+    SurfaceMesh mesh({a, b, m, p, q, r}, {{1, 2, 3}, {2, 0, 3}, {1, 0, 4}, {0, 1, 5}});
+    ASSERT_TRUE(is_intersection_free(mesh));
+
+    RemeshOptions options;
+    ImproveContext context;
+    context.xi = 0.002;  // α = 0.003: only (a, b), 0.0039 long, has two triangles and is long
+    context.allow_topology_changes = false;
+    const SplitReport report = split_long_edges(mesh, options, context);
+    EXPECT_EQ(report.refused_midpoint, 1);
+    EXPECT_EQ(report.splits, 0);
+    EXPECT_TRUE(is_intersection_free(mesh));
+
+    // Without collision safety the split goes ahead and the sheets intersect: the check is
+    // what keeps them apart.
+    context.collision_safety = false;
+    SurfaceMesh unsafe({a, b, m, p, q, r}, {{1, 2, 3}, {2, 0, 3}, {1, 0, 4}, {0, 1, 5}});
+    EXPECT_EQ(split_long_edges(unsafe, options, context).splits, 1);
+    EXPECT_FALSE(is_intersection_free(unsafe));
 }
 
 }  // namespace

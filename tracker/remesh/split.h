@@ -20,6 +20,9 @@ struct SplitReport {
     int butterfly_collides = 0;     ///< of those, kept at the midpoint: butterfly motion collided
     int butterfly_unavailable = 0;  ///< of those, at the midpoint: no butterfly stencil
     int volume_limited = 0;  ///< of those, offset from the midpoint scaled back to change the volume by γ
+    /// long edges not split because the rounded midpoint would make the new triangles
+    /// intersect something (exactly, the midpoint cannot)
+    int refused_midpoint = 0;
     int skipped_boundary = 0;       ///< long boundary edges left alone (§4.4)
     int skipped_nonmanifold = 0;    ///< long non-manifold edges left alone
     int passes = 0;                 ///< sweeps over the long edges
@@ -33,6 +36,11 @@ bool split_allowed(const SurfaceMesh& mesh, int ei);
 /// True when moving new vertex `vi` (just created at a midpoint) to `target` may collide.
 bool split_butterfly_collides(const SurfaceMesh& mesh, const ElementHash& hash, int vi,
                               const Vec3& target);
+
+/// True when the four triangles of splitting edge `ei` at `midpoint` (its rounded midpoint)
+/// would be degenerate or intersect another triangle (exact test; `hash` current).
+bool split_midpoint_intersects(const SurfaceMesh& mesh, const ElementHash& hash, int ei,
+                               const Vec3& midpoint);
 
 /// Splits every edge longer than α, longest first, sweeping until none is left or
 /// `options.max_split_passes` sweeps ran. With `context.collision_safety` off the target is
