@@ -270,6 +270,14 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
              "β: minimum edge length");
     v.number("max_volume_change_fraction", o.max_volume_change_fraction, Range::positive(), "ξ³",
              "γ: largest volume change of one flip or collapse");
+    v.number("curvature_edge_fraction", o.curvature_edge_fraction, Range::non_negative(),
+             "radians",
+             "experimental curvature-adaptive sizing (not in the paper; needs "
+             "split_on_fitted_surface): where the surface has curvature κ, α and β shrink so edges "
+             "turn by at most this angle (α·s, β·s with s = min(1, c/(κα))); 0 keeps α and β");
+    v.number("min_curvature_size_fraction", o.min_curvature_size_fraction,
+             Range{0.0, 1.0, true, false}, "",
+             "smallest factor s of curvature-adaptive sizing (α and β never fall below s·α, s·β)");
     v.integer("max_split_passes", o.max_split_passes, Range::between(1, 100), "",
               "sweeps over long edges per step");
     v.integer("max_collapse_passes", o.max_collapse_passes, Range::between(1, 100), "",

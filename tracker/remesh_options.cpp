@@ -29,6 +29,15 @@ void RemeshOptions::validate() const {
             "RemeshOptions::max_edge_fraction", "must be finite and > min_edge_fraction");
     require(finite_positive(max_volume_change_fraction),
             "RemeshOptions::max_volume_change_fraction", "must be finite and > 0");
+    require(std::isfinite(curvature_edge_fraction) && curvature_edge_fraction >= 0.0,
+            "RemeshOptions::curvature_edge_fraction", "must be finite and >= 0");
+    require(curvature_edge_fraction == 0.0 || split_on_fitted_surface,
+            "RemeshOptions::curvature_edge_fraction",
+            "> 0 needs split_on_fitted_surface (butterfly points on graded meshes add bumps "
+            "that the curvature estimate then refines without end)");
+    require(std::isfinite(min_curvature_size_fraction) && min_curvature_size_fraction > 0.0 &&
+                min_curvature_size_fraction <= 1.0,
+            "RemeshOptions::min_curvature_size_fraction", "must be in (0, 1]");
     require(max_split_passes >= 1, "RemeshOptions::max_split_passes", "must be >= 1");
     require(max_collapse_passes >= 1, "RemeshOptions::max_collapse_passes", "must be >= 1");
     require(max_flip_sweeps >= 1, "RemeshOptions::max_flip_sweeps", "must be >= 1");

@@ -20,6 +20,24 @@ struct RemeshOptions {
     double max_edge_fraction = 1.5;           ///< α / ξ: edges longer than α are split, > min
     double min_edge_fraction = 0.5;           ///< β / ξ: edges shorter than β collapse, > 0
     double max_volume_change_fraction = 0.1;  ///< γ / ξ³ per flip, collapse or split, > 0
+    /// Curvature-adaptive sizing (remesh/sizing.h), not in the paper: c > 0 lowers α and β by
+    /// the same factor s = clamp(c / (κ α), min_curvature_size_fraction, 1) where the surface
+    /// turns with curvature κ, so edges there turn by at most about c radians (a neck of radius
+    /// r keeps about 2π/c edges around it). 0 (the default) keeps α and β everywhere; ≥ 0.
+    /// Experimental, used by no scene or validation case: on the A2 dumbbell at ξ = 0.04
+    /// (c = 0.5, s_min = 0.125) L∞ fell from 2.4e-3 to 1.6e-3 and the pinch-off came 6e-4 s
+    /// earlier, nearer the reference; but at ξ = 0.02 the run stalled at the pinch (t = 0.01595:
+    /// collision resolution found no admissible motion at edges of ξ/16), and with s_min =
+    /// 1/16 at ξ = 0.04 one run built an impact zone too large for memory (hence
+    /// CollisionOptions::max_zone_matrix_entries), then spent over 10 minutes in one step.
+    /// Needs split_on_fitted_surface: butterfly points on the irregular stencils of a graded
+    /// mesh leave bumps, the curvature estimate sees them and refines further, without end
+    /// (a static dumbbell handle went from 18 to 700 vertices in 12 improvements, splitting and
+    /// collapsing 600 edges each; with fitted points it settled at 270 in 3).
+    double curvature_edge_fraction = 0.0;
+    /// Smallest s of curvature-adaptive sizing, in (0, 1]: α and β never fall below this
+    /// fraction (thin folds would otherwise refine without bound).
+    double min_curvature_size_fraction = 0.25;
 
     int max_split_passes = 4;     ///< sweeps over long edges per improvement, ≥ 1
     /// New split vertices go onto a quadratic height field fitted over both endpoints' one-rings

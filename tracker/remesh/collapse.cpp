@@ -3,6 +3,7 @@
 #include "tracker/quadric.h"
 #include "tracker/remesh/butterfly.h"
 #include "tracker/remesh/local_safety.h"
+#include "tracker/remesh/sizing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -300,23 +301,33 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
     };
 
     for (int pass = 0; pass < options.max_collapse_passes; ++pass) {
-        std::vector<std::pair<double, Edge>> short_edges;
+        // β (and the α no new edge may exceed) per edge, lower where the surface turns with
+        // curvature-adaptive sizing; measured once per pass.
+        const EdgeSizing sizing(mesh, options, context.xi);
+        struct ShortEdge {
+            double fraction;  ///< length / β
+            double scale;     ///< sizing factor s of β and α
+            Edge edge;
+        };
+        std::vector<ShortEdge> short_edges;
         for (int ei = 0; ei < mesh.num_edges(); ++ei) {
             if (!mesh.edge_alive(ei))
                 continue;
+            const Edge& e = mesh.edge(ei);
+            const double scale = sizing.scale(e[0], e[1]);
             const double length = edge_length(mesh, ei);
-            if (length < limits.min_edge_length)
-                short_edges.push_back({length, mesh.edge(ei)});
+            if (length < limits.min_edge_length * scale)
+                short_edges.push_back({length / (limits.min_edge_length * scale), scale, e});
         }
         if (short_edges.empty())
             break;
         ++report.passes;
         std::sort(short_edges.begin(), short_edges.end(),
-                  [](const auto& a, const auto& b) { return a.first < b.first; });
+                  [](const ShortEdge& a, const ShortEdge& b) { return a.fraction < b.fraction; });
         int collapses_this_pass = 0;
-        for (const auto& [length, e] : short_edges) {
+        for (const auto& [fraction, scale, e] : short_edges) {
             const int ei = mesh.find_edge(e[0], e[1]);
-            if (ei == INVALID_INDEX || edge_length(mesh, ei) >= limits.min_edge_length)
+            if (ei == INVALID_INDEX || edge_length(mesh, ei) >= limits.min_edge_length * scale)
                 continue;
             if (collapse_touches_boundary(mesh, ei)) {
                 ++report.skipped_boundary;
@@ -341,7 +352,7 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
                     refusal = Refusal::normal;
                 else if (collapse_changes_volume_too_much(mesh, plan, limits.max_volume_change))
                     refusal = Refusal::volume;
-                else if (collapse_creates_long_edge(mesh, plan, limits.max_edge_length))
+                else if (collapse_creates_long_edge(mesh, plan, limits.max_edge_length * scale))
                     refusal = Refusal::long_edge;
                 else if (context.collision_safety && collapse_collides(mesh, current_hash(), plan))
                     refusal = Refusal::collision;

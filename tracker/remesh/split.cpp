@@ -3,6 +3,7 @@
 #include "tracker/remesh/butterfly.h"
 #include "tracker/remesh/element_hash.h"
 #include "tracker/remesh/local_safety.h"
+#include "tracker/remesh/sizing.h"
 #include "tracker/remesh/smooth.h"
 #include "tracker/remesh/surface_fit.h"
 #include "tracker/quadric.h"
@@ -61,7 +62,6 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
     const auto start = std::chrono::steady_clock::now();
     SplitReport report;
     const RemeshLimits limits = remesh_limits(options, context.xi);
-    const double alpha = limits.max_edge_length;
     const double gamma = limits.max_volume_change;
     const FeatureThresholds thresholds{options.ridge_eigenvalue_ratio,
                                        options.corner_eigenvalue_ratio};
@@ -77,21 +77,31 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
     };
 
     for (int pass = 0; pass < options.max_split_passes; ++pass) {
-        std::vector<std::pair<double, Edge>> long_edges;
+        // α per edge (lower where the surface turns, with curvature-adaptive sizing),
+        // measured once per pass; its ratio to the length orders the splits.
+        const EdgeSizing sizing(mesh, options, context.xi);
+        struct LongEdge {
+            double excess;  ///< length / α
+            double alpha;
+            Edge edge;
+        };
+        std::vector<LongEdge> long_edges;
         for (int ei = 0; ei < mesh.num_edges(); ++ei) {
             if (!mesh.edge_alive(ei))
                 continue;
+            const Edge& e = mesh.edge(ei);
+            const double alpha = sizing.max_length(e[0], e[1]);
             const double length = edge_length(mesh, ei);
             if (length > alpha)
-                long_edges.push_back({length, mesh.edge(ei)});
+                long_edges.push_back({length / alpha, alpha, e});
         }
         if (long_edges.empty())
             break;
         ++report.passes;
         std::sort(long_edges.begin(), long_edges.end(),
-                  [](const auto& a, const auto& b) { return a.first > b.first; });
+                  [](const LongEdge& a, const LongEdge& b) { return a.excess > b.excess; });
         int splits_this_pass = 0;
-        for (const auto& [length, e] : long_edges) {
+        for (const auto& [excess, alpha, e] : long_edges) {
             const int ei = mesh.find_edge(e[0], e[1]);
             if (ei == INVALID_INDEX || edge_length(mesh, ei) <= alpha)
                 continue;

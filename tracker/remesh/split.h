@@ -1,6 +1,8 @@
 #pragma once
-/// \file Edge split (paper §3.5.1): edges longer than α get a new vertex, first at the midpoint
-/// (which cannot create an intersection), then moved to its target as a pseudo-motion checked by
+/// \file Edge split (paper §3.5.1): edges longer than α (lowered where the surface turns, with
+/// curvature-adaptive sizing: remesh/sizing.h) get a new vertex, first at the midpoint (which
+/// cannot create an intersection in exact arithmetic; with collision safety the rounded one is
+/// checked), then moved to its target as a pseudo-motion checked by
 /// CCD; if that motion may collide the vertex stays at the midpoint. The target is the butterfly
 /// point, or with RemeshOptions::split_on_fitted_surface the fitted-surface or circular-arc
 /// point of remesh/surface_fit.h where those exist. Boundary and non-manifold edges are never
