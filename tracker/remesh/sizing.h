@@ -6,8 +6,9 @@
 /// With RemeshOptions::curvature_edge_fraction = c > 0, an edge whose endpoints see curvature κ
 /// is split above α·s and collapsed below β·s, with s = clamp(c / (κ α), s_min, 1): edges turn
 /// by at most about c radians, and β/α keeps its ratio so splits and collapses never undo each
-/// other. κ at a vertex is the largest turning of the area-weighted vertex normal per unit
-/// length towards any neighbour (1/r on a sphere or cylinder of radius r, at any resolution).
+/// other. κ at a vertex is the larger principal curvature, in magnitude, of a least-squares fit
+/// of the vertex normals' variation over its one-ring (1/r on a sphere or a tube of radius r,
+/// at any resolution).
 
 #include "tracker/mesh.h"
 #include "tracker/remesh_options.h"
@@ -16,8 +17,11 @@
 
 namespace meniscus::tracker {
 
-/// Per-vertex curvature estimate: max over neighbours w of angle(n_v, n_w) / |x_v − x_w|
-/// (1/m; 0 for dead or isolated vertices). Sized num_vertices().
+/// Per-vertex curvature estimate (1/m): with area-weighted normals n, the symmetric 2×2 S in
+/// the tangent plane of n_v fitting n_w − n_v ≈ S (x_w − x_v) over the neighbours w (each
+/// weighted by 1/|x_w − x_v|²), and max |eigenvalue of S|; where the neighbours do not span
+/// the plane, the largest angle(n_v, n_w) / |x_v − x_w|. 0 for dead or isolated vertices.
+/// Sized num_vertices().
 std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh);
 
 /// Edge-length limits for one pass over the mesh. The curvature is measured when the object is
