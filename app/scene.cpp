@@ -277,7 +277,12 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
              "turn by at most this angle (α·s, β·s with s = min(1, c/(κα))); 0 keeps α and β");
     v.number("min_curvature_size_fraction", o.min_curvature_size_fraction,
              Range{0.0, 1.0, true, false}, "",
-             "smallest factor s of curvature-adaptive sizing (α and β never fall below s·α, s·β)");
+             "smallest factor s of curvature-adaptive and thin-sheet sizing (α and β never fall "
+             "below s·α, s·β)");
+    v.number("thin_sheet_sag_fraction", o.thin_sheet_sag_fraction, Range::non_negative(), "",
+             "experimental thin-sheet sizing (not in the paper; needs split_on_fitted_surface): "
+             "where a vertex faces an opposite-facing part of the surface at distance h, α and β "
+             "shrink until the chord sag of edges there is at most this fraction of h; 0 is off");
     v.integer("max_split_passes", o.max_split_passes, Range::between(1, 100), "",
               "sweeps over long edges per step");
     v.integer("max_collapse_passes", o.max_collapse_passes, Range::between(1, 100), "",

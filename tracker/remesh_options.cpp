@@ -35,6 +35,12 @@ void RemeshOptions::validate() const {
             "RemeshOptions::curvature_edge_fraction",
             "> 0 needs split_on_fitted_surface (butterfly points on graded meshes add bumps "
             "that the curvature estimate then refines without end)");
+    require(std::isfinite(thin_sheet_sag_fraction) && thin_sheet_sag_fraction >= 0.0,
+            "RemeshOptions::thin_sheet_sag_fraction", "must be finite and >= 0");
+    require(thin_sheet_sag_fraction == 0.0 || split_on_fitted_surface,
+            "RemeshOptions::thin_sheet_sag_fraction",
+            "> 0 needs split_on_fitted_surface (butterfly points on graded meshes add bumps "
+            "that the curvature estimate then refines without end)");
     require(std::isfinite(min_curvature_size_fraction) && min_curvature_size_fraction > 0.0 &&
                 min_curvature_size_fraction <= 1.0,
             "RemeshOptions::min_curvature_size_fraction", "must be in (0, 1]");

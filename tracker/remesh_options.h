@@ -38,6 +38,15 @@ struct RemeshOptions {
     /// Smallest s of curvature-adaptive sizing, in (0, 1]: α and β never fall below this
     /// fraction (thin folds would otherwise refine without bound).
     double min_curvature_size_fraction = 0.25;
+    /// Thin-sheet sizing (remesh/sizing.h), not in the paper: f > 0 lowers α and β (by the same
+    /// factor s, floored at min_curvature_size_fraction) where a vertex faces another part of
+    /// the surface — a triangle whose normal opposes the vertex normal — at a distance h that
+    /// the chord sag κ(sα)²/8 of edges at the vertex's curvature κ would exceed f·h. The two
+    /// discretized sides of a sheet thinner than their chord sag meet and are then held apart
+    /// by collision handling while the flow stretches them (A4's volume gain). 0 (the default)
+    /// turns it off; ≥ 0. Experimental. Needs split_on_fitted_surface, like
+    /// curvature_edge_fraction.
+    double thin_sheet_sag_fraction = 0.0;
 
     int max_split_passes = 4;     ///< sweeps over long edges per improvement, ≥ 1
     /// New split vertices go onto a quadratic height field fitted over both endpoints' one-rings

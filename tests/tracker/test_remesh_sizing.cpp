@@ -1,11 +1,14 @@
 /// Curvature-adaptive sizing (remesh/sizing.h): the curvature estimate is 1/r on round
 /// surfaces, the scale factor obeys its clamp, and split/collapse with it refine a thin handle
 /// without the collapses undoing the splits. Added with the A2 dumbbell work (issue #5), where
-/// a neck only a few edges around pinched late.
+/// a neck only a few edges around pinched late. Thin-sheet sizing (the facing distance and the
+/// sag bound) was added with the A4 curl-noise work, where the two discretized sides of sheets
+/// thinner than their chord sag met and were held apart.
 
 #include "remesh_test_meshes.h"
 
 #include "tracker/mesh_intersections.h"
+#include "tracker/mesh_measures.h"
 #include "tracker/mesh_validate.h"
 #include "tracker/remesh/improve.h"
 #include "tracker/remesh/sizing.h"
@@ -114,6 +117,154 @@ TEST(RemeshSizing, InvalidOptionsNameTheField) {
     }
     options.min_curvature_size_fraction = 0.25;
     EXPECT_THROW(EdgeSizing(sphere, options, 0.0), std::invalid_argument);
+}
+
+/// A spherical shell: make_test_sphere (radius 0.25, ξ ≈ 0.06) and, inside it, a rotated
+/// copy scaled to radius 0.25 − thickness with its orientation reversed (normals point into the
+/// hollow), so the two sides face each other across a sheet with vertices that do not line up.
+SurfaceMesh make_shell(double thickness) {
+    const SurfaceMesh outer = testing::make_test_sphere();
+    std::vector<Vec3> positions = outer.positions();
+    std::vector<Triangle> triangles;
+    for (int ti = 0; ti < outer.num_triangles(); ++ti)
+        triangles.push_back(outer.triangle(ti));
+    const int n = outer.num_vertices();
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(0.3, Vec3(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+    const double scale = (0.25 - thickness) / 0.25;
+    for (int vi = 0; vi < n; ++vi)
+        positions.push_back(scale * (rotation * outer.position(vi)));
+    const int m = static_cast<int>(triangles.size());
+    for (int k = 0; k < m; ++k) {
+        const Triangle& t = triangles[static_cast<size_t>(k)];
+        triangles.push_back({t[0] + n, t[2] + n, t[1] + n});
+    }
+    return SurfaceMesh(positions, triangles);
+}
+
+TEST(RemeshSizing, FacingDistanceIsTheSheetThicknessAndSkipsTheSameSide) {
+    constexpr double THICKNESS = 0.004;
+    const SurfaceMesh shell = make_shell(THICKNESS);
+    const std::vector<Vec3> normals = area_weighted_vertex_normals(shell);
+    const std::vector<double> radius(static_cast<size_t>(shell.num_vertices()), 0.05);
+    const std::vector<double> h = vertex_facing_distance(shell, normals, radius);
+    // Outer vertices lie on the outer sphere; the inner triangles lie inside the inner sphere
+    // by at most their chord sag ℓ²/(8r) ≈ 0.06²/(8 · 0.246) ≈ 1.8e-3 (ℓ up to about 1.5ξ
+    // would give 4e-3). Inner vertices see the outer triangles, whose chords come nearer.
+    const int half = shell.num_vertices() / 2;
+    for (int vi = 0; vi < shell.num_vertices(); ++vi) {
+        const double d = h[static_cast<size_t>(vi)];
+        ASSERT_TRUE(std::isfinite(d)) << vi;
+        if (vi < half) {
+            ASSERT_GE(d, THICKNESS - 1e-12) << vi;
+            ASSERT_LE(d, THICKNESS + 4e-3) << vi;
+        } else {
+            ASSERT_LE(d, THICKNESS + 1e-12) << vi;
+            ASSERT_GE(d, 0.0) << vi;
+        }
+    }
+    // On a lone sphere nothing within the radius faces a vertex (the far side is 0.5 away),
+    // and a radius of 0 skips the vertex.
+    const SurfaceMesh sphere = testing::make_test_sphere();
+    const std::vector<double> lone = vertex_facing_distance(
+        sphere, area_weighted_vertex_normals(sphere),
+        std::vector<double>(static_cast<size_t>(sphere.num_vertices()), 0.1));
+    for (double d : lone)
+        ASSERT_TRUE(std::isinf(d));
+    const std::vector<double> skipped = vertex_facing_distance(
+        shell, normals, std::vector<double>(static_cast<size_t>(shell.num_vertices()), 0.0));
+    for (double d : skipped)
+        ASSERT_TRUE(std::isinf(d));
+}
+
+TEST(RemeshSizing, ThinSheetSizingKeepsTheChordSagBelowAFractionOfTheThickness) {
+    constexpr double THICKNESS = 0.004;
+    const SurfaceMesh shell = make_shell(THICKNESS);
+    const double xi = testing::mean_edge_length(shell);
+    RemeshOptions options;
+    options.thin_sheet_sag_fraction = 0.25;
+    options.split_on_fitted_surface = true;
+    options.min_curvature_size_fraction = 0.1;
+    const EdgeSizing sizing(shell, options, xi);
+    ASSERT_TRUE(sizing.adaptive());
+    const double alpha = sizing.limits().max_edge_length;
+    // s = sqrt(8 f h / κ) / α with κ ≈ 1/0.25 and h between the thickness and the thickness
+    // plus the inner chord sag (previous test).
+    const double low = std::sqrt(8.0 * 0.25 * THICKNESS * 0.25) / alpha;
+    const double high = std::sqrt(8.0 * 0.25 * (THICKNESS + 2e-3) * 0.25) / alpha;
+    ASSERT_LT(high, 1.0) << "the case must refine";
+    std::vector<double> outer_scales;
+    for (int ei = 0; ei < shell.num_edges(); ++ei) {
+        const Edge& e = shell.edge(ei);
+        if (e[0] < shell.num_vertices() / 2)
+            outer_scales.push_back(sizing.scale(e[0], e[1]));
+    }
+    const double m = median(outer_scales);
+    EXPECT_GT(m, 0.8 * low);
+    EXPECT_LT(m, 1.1 * high);
+    // The same options leave a lone sphere (nothing faces it) and a thick shell (sag below
+    // f·h) at the nominal limits.
+    for (const SurfaceMesh& mesh : {testing::make_test_sphere(), make_shell(0.05)}) {
+        const EdgeSizing nominal(mesh, options, xi);
+        for (int ei = 0; ei < mesh.num_edges(); ++ei) {
+            const Edge& e = mesh.edge(ei);
+            ASSERT_EQ(nominal.scale(e[0], e[1]), 1.0);
+        }
+    }
+
+    // Improvement refines the thin shell to the sizing and keeps it valid and apart.
+    SurfaceMesh refined = shell;
+    ImproveContext context;
+    context.xi = xi;
+    context.allow_topology_changes = false;
+    for (int k = 0; k < 4; ++k)
+        improve_mesh(refined, options, context);
+    EXPECT_GT(refined.count_live_triangles(), 2 * shell.count_live_triangles());
+    EXPECT_TRUE(validate_mesh(refined).empty());
+    EXPECT_TRUE(is_intersection_free(refined));
+
+    options.thin_sheet_sag_fraction = -1.0;
+    try {
+        EdgeSizing(shell, options, xi);
+        FAIL() << "no throw";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("thin_sheet_sag_fraction"), std::string::npos);
+    }
+    options.thin_sheet_sag_fraction = 0.25;
+    options.split_on_fitted_surface = false;
+    EXPECT_THROW(EdgeSizing(shell, options, xi), std::invalid_argument);
+}
+
+TEST(RemeshSizing, TargetLengthIsGradedAwayFromARefinedSpot) {
+    // Curvature sizing on the torus refines the whole tube; a shell thin only near one pole
+    // refines a spot. In both the target length s α may rise by at most SIZE_GRADING per metre
+    // along each edge (s of an edge's endpoints, through scale(v, v)).
+    SurfaceMesh shell = make_shell(0.05);
+    const int half = shell.num_vertices() / 2;
+    for (int vi = half; vi < shell.num_vertices(); ++vi) {
+        const Vec3 x = shell.position(vi);
+        if (x.z() > 0.15)  // pull the inner sphere's cap up to 3 mm below the outer one
+            shell.set_position(vi, x * (0.247 / x.norm()));
+    }
+    const double xi = testing::mean_edge_length(shell);
+    RemeshOptions options;
+    options.thin_sheet_sag_fraction = 0.25;
+    options.split_on_fitted_surface = true;
+    options.min_curvature_size_fraction = 0.1;
+    const EdgeSizing sizing(shell, options, xi);
+    const double alpha = sizing.limits().max_edge_length;
+    int refined = 0, graded = 0;
+    for (int ei = 0; ei < shell.num_edges(); ++ei) {
+        const Edge& e = shell.edge(ei);
+        const double ha = sizing.scale(e[0], e[0]) * alpha;
+        const double hb = sizing.scale(e[1], e[1]) * alpha;
+        const double length = (shell.position(e[0]) - shell.position(e[1])).norm();
+        ASSERT_LE(std::abs(ha - hb), SIZE_GRADING * length * (1.0 + 1e-12)) << ei;
+        refined += ha < 0.5 * alpha;
+        graded += ha < alpha && shell.position(e[0]).z() < 0.1;
+    }
+    EXPECT_GT(refined, 0) << "the thin cap refines";
+    EXPECT_GT(graded, 0) << "the grading reaches past the cap";
 }
 
 /// Edges of the handle (|x| < 0.04, well inside the blends) crossing the plane x = 0.

@@ -1,17 +1,30 @@
 #include "tracker/remesh/sizing.h"
 
+#include "tracker/broadphase.h"
+#include "tracker/distance.h"
 #include "tracker/mesh_measures.h"
 
 #include <Eigen/Eigenvalues>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <queue>
+#include <utility>
 #include <stdexcept>
 
 namespace meniscus::tracker {
 
 std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh) {
-    const std::vector<Vec3> normals = area_weighted_vertex_normals(mesh);
+    return vertex_turning_curvature(mesh, area_weighted_vertex_normals(mesh));
+}
+
+std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh,
+                                             const std::vector<Vec3>& normals) {
+    if (normals.size() != static_cast<size_t>(mesh.num_vertices()))
+        throw std::invalid_argument("vertex_turning_curvature: one normal per vertex needed");
     std::vector<double> curvature(static_cast<size_t>(mesh.num_vertices()), 0.0);
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
         const Vec3& n = normals[static_cast<size_t>(vi)];
@@ -55,21 +68,141 @@ std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh) {
     return curvature;
 }
 
+std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
+                                           const std::vector<Vec3>& normals,
+                                           const std::vector<double>& radius) {
+    const size_t n = static_cast<size_t>(mesh.num_vertices());
+    if (normals.size() != n || radius.size() != n)
+        throw std::invalid_argument("vertex_facing_distance: one normal and radius per vertex");
+    std::vector<double> distance(n, std::numeric_limits<double>::infinity());
+    double largest = 0.0;
+    for (size_t vi = 0; vi < n; ++vi)
+        if (radius[vi] > 0.0 && std::isfinite(radius[vi]))
+            largest = std::max(largest, radius[vi]);
+    if (!(largest > 0.0))
+        return distance;
+    // Triangles by box, with their unit normals; hash cells as large as the larger of the
+    // mean box and the search radius (cells much smaller than the boxes make every box span
+    // many cells).
+    std::vector<Vec3> triangle_normal(static_cast<size_t>(mesh.num_triangles()), Vec3::Zero());
+    std::vector<Box3d> boxes(static_cast<size_t>(mesh.num_triangles()));
+    double extent_sum = 0.0;
+    int counted = 0;
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti))
+            continue;
+        const auto& t = mesh.triangle(ti);
+        const Vec3 &a = mesh.position(t[0]), &b = mesh.position(t[1]), &c = mesh.position(t[2]);
+        const Vec3 normal = (b - a).cross(c - a);
+        if (!(normal.squaredNorm() > 0.0))
+            continue;
+        triangle_normal[static_cast<size_t>(ti)] = normal.normalized();
+        Box3d& box = boxes[static_cast<size_t>(ti)];
+        box.extend(a);
+        box.extend(b);
+        box.extend(c);
+        extent_sum += box.sizes().maxCoeff();
+        ++counted;
+    }
+    if (counted == 0)
+        return distance;
+    SpatialHash triangles(std::max(largest, extent_sum / counted));
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        if (!triangle_normal[static_cast<size_t>(ti)].isZero())
+            triangles.insert(ti, boxes[static_cast<size_t>(ti)]);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<int> candidates;
+        for (size_t vi = r.begin(); vi != r.end(); ++vi) {
+            const Vec3& nv = normals[vi];
+            if (!(radius[vi] > 0.0) || !mesh.vertex_alive(static_cast<int>(vi)) || nv.isZero())
+                continue;
+            const Vec3& x = mesh.position(static_cast<int>(vi));
+            const Vec3 reach = Vec3::Constant(radius[vi]);
+            triangles.query(Box3d(x - reach, x + reach), candidates);
+            double best = radius[vi];
+            bool found = false;
+            for (int ti : candidates) {
+                const auto& t = mesh.triangle(ti);
+                if (t[0] == static_cast<int>(vi) || t[1] == static_cast<int>(vi) ||
+                    t[2] == static_cast<int>(vi) ||
+                    !(triangle_normal[static_cast<size_t>(ti)].dot(nv) < -0.5))
+                    continue;
+                const double d = point_triangle_proximity(x, mesh.position(t[0]),
+                                                          mesh.position(t[1]), mesh.position(t[2]))
+                                     .distance;
+                if (d <= best) {
+                    best = d;
+                    found = true;
+                }
+            }
+            if (found)
+                distance[vi] = best;
+        }
+    });
+    return distance;
+}
+
 EdgeSizing::EdgeSizing(const SurfaceMesh& mesh, const RemeshOptions& options, double xi) {
     options.validate();
     if (!(xi > 0.0) || !std::isfinite(xi))
         throw std::invalid_argument("EdgeSizing: xi must be finite and > 0");
     m_limits = remesh_limits(options, xi);
-    if (options.curvature_edge_fraction == 0.0)
+    const double c = options.curvature_edge_fraction;
+    const double f = options.thin_sheet_sag_fraction;
+    if (c == 0.0 && f == 0.0)
         return;
-    const std::vector<double> curvature = vertex_turning_curvature(mesh);
-    m_scale.resize(curvature.size());
+    const std::vector<Vec3> normals = area_weighted_vertex_normals(mesh);
+    const std::vector<double> curvature = vertex_turning_curvature(mesh, normals);
+    const double alpha = m_limits.max_edge_length;
     const double floor = options.min_curvature_size_fraction;
-    for (size_t vi = 0; vi < curvature.size(); ++vi) {
-        const double k = curvature[vi] * m_limits.max_edge_length;
-        m_scale[vi] = k > options.curvature_edge_fraction
-                          ? std::max(floor, options.curvature_edge_fraction / k)
-                          : 1.0;
+    m_scale.assign(curvature.size(), 1.0);
+    if (c > 0.0) {
+        for (size_t vi = 0; vi < curvature.size(); ++vi) {
+            const double k = curvature[vi] * alpha;
+            if (k > c)
+                m_scale[vi] = std::max(floor, c / k);
+        }
+    }
+    if (f > 0.0) {
+        // Search as far as a facing triangle could still lower s: sag κα²/8 > f h.
+        std::vector<double> radius(curvature.size(), 0.0);
+        for (size_t vi = 0; vi < curvature.size(); ++vi)
+            radius[vi] = std::min(alpha, curvature[vi] * alpha * alpha / (8.0 * f));
+        const std::vector<double> h = vertex_facing_distance(mesh, normals, radius);
+        for (size_t vi = 0; vi < curvature.size(); ++vi) {
+            if (!std::isfinite(h[vi]) || !(curvature[vi] > 0.0))
+                continue;
+            const double s = std::sqrt(8.0 * f * h[vi] / curvature[vi]) / alpha;
+            if (s < 1.0)
+                m_scale[vi] = std::min(m_scale[vi], std::max(floor, s));
+        }
+    }
+    grade(mesh);
+}
+
+void EdgeSizing::grade(const SurfaceMesh& mesh) {
+    // Dijkstra over the edge graph on the target length H = s α: H_v ≤ H_w + g |x_v − x_w|.
+    const double alpha = m_limits.max_edge_length;
+    using Item = std::pair<double, int>;  // (H, vertex)
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+    for (size_t vi = 0; vi < m_scale.size(); ++vi)
+        if (m_scale[vi] < 1.0 && mesh.vertex_alive(static_cast<int>(vi)))
+            queue.emplace(m_scale[vi] * alpha, static_cast<int>(vi));
+    while (!queue.empty()) {
+        const auto [h, vi] = queue.top();
+        queue.pop();
+        if (h > m_scale[static_cast<size_t>(vi)] * alpha)
+            continue;  // stale entry
+        for (int ei : mesh.vertex_edges(vi)) {
+            const int wi = mesh.other_vertex(ei, vi);
+            const double reach =
+                h + SIZE_GRADING * (mesh.position(wi) - mesh.position(vi)).norm();
+            double& sw = m_scale[static_cast<size_t>(wi)];
+            if (reach < sw * alpha) {
+                sw = reach / alpha;
+                queue.emplace(reach, wi);
+            }
+        }
     }
 }
 

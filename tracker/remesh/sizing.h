@@ -9,6 +9,11 @@
 /// other. κ at a vertex is the larger principal curvature, in magnitude, of a least-squares fit
 /// of the vertex normals' variation over its one-ring (1/r on a sphere or a tube of radius r,
 /// at any resolution).
+///
+/// With RemeshOptions::thin_sheet_sag_fraction = f > 0, s is also at most sqrt(8 f h / κ) / α
+/// (floored at s_min) where the vertex faces another part of the surface at distance h
+/// (vertex_facing_distance): the chord sag κ(sα)²/8 stays below f·h, so the two discretized
+/// sides of a thin, curved sheet do not meet before the sheet itself closes.
 
 #include "tracker/mesh.h"
 #include "tracker/remesh_options.h"
@@ -23,6 +28,23 @@ namespace meniscus::tracker {
 /// the plane, the largest angle(n_v, n_w) / |x_v − x_w|. 0 for dead or isolated vertices.
 /// Sized num_vertices().
 std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh);
+/// The same from given unit (or zero) vertex normals, sized num_vertices().
+std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh,
+                                             const std::vector<Vec3>& normals);
+
+/// Per-vertex distance (m) to the nearest live triangle that does not contain the vertex and
+/// faces it: the triangle's normal opposes the vertex normal (n_t · n_v < −1/2), as the other
+/// side of a thin sheet or of a thin gap does. Only triangles within radius[v] are searched
+/// (radius ≤ 0 skips the vertex); +∞ where none is found. Sized num_vertices().
+std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
+                                           const std::vector<Vec3>& normals,
+                                           const std::vector<double>& radius);
+
+/// Largest growth of the adaptive target edge length per unit distance along the mesh: after
+/// the curvature and thin-sheet terms, s α is graded so that it rises by at most this much per
+/// metre away from a refined vertex. Without it a lone refined vertex gets a fan of split edges
+/// whose outer triangles are slivers (A4 with thin-sheet sizing: minimum angles of 0.1°).
+constexpr double SIZE_GRADING = 0.5;
 
 /// Edge-length limits for one pass over the mesh. The curvature is measured when the object is
 /// built; vertices created afterwards get the nominal limits (s = 1) until the next pass.
@@ -39,6 +61,7 @@ public:
     bool adaptive() const { return !m_scale.empty(); }
 
 private:
+    void grade(const SurfaceMesh& mesh);
     RemeshLimits m_limits;
     std::vector<double> m_scale;  ///< per vertex; empty when adaptivity is off
 };
