@@ -10,11 +10,16 @@
 // Topology:
 // two such spheres (half the triangles each) 0.02 ξ apart, so the merge pass finds proximal
 // edges and zips; each iteration works on a fresh copy. Counters are per iteration.
+// Thin-sheet sizing: the EdgeSizing measurement (curvature, facing distances, grading) on a
+// spherical shell (outer sphere and a reversed inner one, half the triangles each) whose
+// thickness is SHELL_SAG_FRACTION times the chord sag of an edge of length α = 1.5 ξ, so every
+// vertex faces the other side nearer than the sag allows and is refined.
 
 #include "tracker/implicit_mesher.h"
 #include "tracker/implicit_shape.h"
 #include "tracker/mesh_measures.h"
 #include "tracker/remesh/improve.h"
+#include "tracker/remesh/sizing.h"
 #include "tracker/topology/change_topology.h"
 
 #include <benchmark/benchmark.h>
@@ -32,6 +37,7 @@ using meniscus::tracker::Vec3;
 constexpr double RADIUS = 0.5;
 constexpr double STRETCH = 1.5;
 constexpr double MERGE_GAP_FRACTION = 0.02;  // of ξ, below the default merge distance 0.1 ξ
+constexpr double SHELL_SAG_FRACTION = 0.25;  // shell thickness / ((1.5 ξ)² / (8 RADIUS))
 
 /// Edge length giving about `triangles` triangles on a sphere of radius r (equilateral).
 double edge_length_for(int triangles, double r) {
@@ -199,6 +205,51 @@ void BM_ChangeTopology(benchmark::State& state) {
     state.counters["separate_s"] = report.separation.seconds;
 }
 
+/// Outer sphere of radius RADIUS and, a quarter of an α-chord's sag inside it, a copy scaled
+/// down with its orientation reversed; half the triangles each.
+const SurfaceMesh& thin_shell(int triangles, double& xi) {
+    static std::map<int, std::pair<SurfaceMesh, double>> cache;
+    auto it = cache.find(triangles);
+    if (it == cache.end()) {
+        const SurfaceMesh outer = sphere_mesh(triangles / 2, RADIUS, Vec3::Zero());
+        const double mean = meniscus::tracker::edge_length_stats(outer).mean;
+        const double thickness = SHELL_SAG_FRACTION * (1.5 * mean) * (1.5 * mean) / (8.0 * RADIUS);
+        const double scale = (RADIUS - thickness) / RADIUS;
+        std::vector<Vec3> positions = outer.positions();
+        std::vector<Triangle> tris;
+        const int n = outer.num_vertices();
+        for (int vi = 0; vi < n; ++vi)
+            positions.push_back(scale * outer.position(vi));
+        for (int ti = 0; ti < outer.num_triangles(); ++ti)
+            tris.push_back(outer.triangle(ti));
+        for (int ti = 0; ti < outer.num_triangles(); ++ti) {
+            const Triangle& t = outer.triangle(ti);
+            tris.push_back({t[0] + n, t[2] + n, t[1] + n});
+        }
+        it = cache.emplace(triangles, std::make_pair(SurfaceMesh(positions, tris), mean)).first;
+    }
+    xi = it->second.second;
+    return it->second.first;
+}
+
+void BM_ThinSheetSizing(benchmark::State& state) {
+    double xi = 0.0;
+    const SurfaceMesh& shell = thin_shell(static_cast<int>(state.range(0)), xi);
+    meniscus::tracker::RemeshOptions options;
+    options.split_on_fitted_surface = true;
+    options.thin_sheet_sag_fraction = 1.5;
+    double refined = 0.0;
+    for (auto _ : state) {
+        const meniscus::tracker::EdgeSizing sizing(shell, options, xi);
+        refined = 0.0;
+        for (int vi = 0; vi < shell.num_vertices(); ++vi)
+            refined += sizing.scale(vi, vi) < 1.0;
+        benchmark::DoNotOptimize(refined);
+    }
+    state.counters["triangles"] = shell.count_live_triangles();
+    state.counters["refined_vertices"] = refined;
+}
+
 BENCHMARK(BM_ImproveMesh)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ImproveMeshSteadyState)
     ->Arg(10000)
@@ -206,6 +257,7 @@ BENCHMARK(BM_ImproveMeshSteadyState)
     ->Arg(200000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ChangeTopology)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ThinSheetSizing)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

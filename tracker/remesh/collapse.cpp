@@ -300,10 +300,10 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
         return *hash;
     };
 
+    // β (and the α no new edge may exceed) per edge, lower where the surface turns or faces
+    // itself with adaptive sizing; measured once per call (a collapse keeps one endpoint).
+    const EdgeSizing sizing(mesh, options, context.xi);
     for (int pass = 0; pass < options.max_collapse_passes; ++pass) {
-        // β (and the α no new edge may exceed) per edge, lower where the surface turns with
-        // curvature-adaptive sizing; measured once per pass.
-        const EdgeSizing sizing(mesh, options, context.xi);
         struct ShortEdge {
             double fraction;  ///< length / β
             double scale;     ///< sizing factor s of β and α

@@ -81,9 +81,7 @@ std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
             largest = std::max(largest, radius[vi]);
     if (!(largest > 0.0))
         return distance;
-    // Triangles by box, with their unit normals; hash cells as large as the larger of the
-    // mean box and the search radius (cells much smaller than the boxes make every box span
-    // many cells).
+    // Triangles by box, with their unit normals; hash cells as large as the mean box.
     std::vector<Vec3> triangle_normal(static_cast<size_t>(mesh.num_triangles()), Vec3::Zero());
     std::vector<Box3d> boxes(static_cast<size_t>(mesh.num_triangles()));
     double extent_sum = 0.0;
@@ -106,37 +104,50 @@ std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
     }
     if (counted == 0)
         return distance;
-    SpatialHash triangles(std::max(largest, extent_sum / counted));
+    SpatialHash triangles(extent_sum / counted);
     for (int ti = 0; ti < mesh.num_triangles(); ++ti)
         if (!triangle_normal[static_cast<size_t>(ti)].isZero())
             triangles.insert(ti, boxes[static_cast<size_t>(ti)]);
+    const double near = extent_sum / counted;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
         std::vector<int> candidates;
         for (size_t vi = r.begin(); vi != r.end(); ++vi) {
             const Vec3& nv = normals[vi];
             if (!(radius[vi] > 0.0) || !mesh.vertex_alive(static_cast<int>(vi)) || nv.isZero())
                 continue;
-            const Vec3& x = mesh.position(static_cast<int>(vi));
-            const Vec3 reach = Vec3::Constant(radius[vi]);
-            triangles.query(Box3d(x - reach, x + reach), candidates);
-            double best = radius[vi];
-            bool found = false;
-            for (int ti : candidates) {
-                const auto& t = mesh.triangle(ti);
-                if (t[0] == static_cast<int>(vi) || t[1] == static_cast<int>(vi) ||
-                    t[2] == static_cast<int>(vi) ||
-                    !(triangle_normal[static_cast<size_t>(ti)].dot(nv) < -0.5))
-                    continue;
-                const double d = point_triangle_proximity(x, mesh.position(t[0]),
-                                                          mesh.position(t[1]), mesh.position(t[2]))
-                                     .distance;
-                if (d <= best) {
-                    best = d;
-                    found = true;
+            const int v = static_cast<int>(vi);
+            const Vec3& x = mesh.position(v);
+            // Nearest facing triangle within `reach` (the box query finds every triangle at
+            // distance ≤ reach); first within one mean triangle size, which usually settles it.
+            const auto nearest = [&](double reach) {
+                triangles.query(Box3d(x - Vec3::Constant(reach), x + Vec3::Constant(reach)),
+                                candidates);
+                double best = reach;
+                bool found = false;
+                for (int ti : candidates) {
+                    // The box's distance bounds the triangle's from below.
+                    if (triangles.box(ti).squaredExteriorDistance(x) > best * best)
+                        continue;
+                    const auto& t = mesh.triangle(ti);
+                    if (t[0] == v || t[1] == v || t[2] == v ||
+                        !(triangle_normal[static_cast<size_t>(ti)].dot(nv) < -0.5))
+                        continue;
+                    const double d = point_triangle_proximity(x, mesh.position(t[0]),
+                                                              mesh.position(t[1]),
+                                                              mesh.position(t[2]))
+                                         .distance;
+                    if (d <= best) {
+                        best = d;
+                        found = true;
+                    }
                 }
-            }
-            if (found)
-                distance[vi] = best;
+                return found ? best : std::numeric_limits<double>::infinity();
+            };
+            const double first = std::min(near, radius[vi]);
+            double d = nearest(first);
+            if (!std::isfinite(d) && radius[vi] > first)
+                d = nearest(radius[vi]);
+            distance[vi] = d;
         }
     });
     return distance;
@@ -204,6 +215,24 @@ void EdgeSizing::grade(const SurfaceMesh& mesh) {
             }
         }
     }
+}
+
+void EdgeSizing::inherit(const SurfaceMesh& mesh, int vi, int a, int b) {
+    if (m_scale.empty() || vi < 0)
+        return;
+    // The graded field's bound at the new vertex: H ≤ H_w + g |x − x_w| for both endpoints.
+    const auto of = [this](int w) {
+        return w >= 0 && static_cast<size_t>(w) < m_scale.size() ? m_scale[static_cast<size_t>(w)]
+                                                                  : 1.0;
+    };
+    const Vec3& x = mesh.position(vi);
+    const double alpha = m_limits.max_edge_length;
+    const double s = std::min(
+        {1.0, of(a) + SIZE_GRADING * (x - mesh.position(a)).norm() / alpha,
+         of(b) + SIZE_GRADING * (x - mesh.position(b)).norm() / alpha});
+    if (static_cast<size_t>(vi) >= m_scale.size())
+        m_scale.resize(static_cast<size_t>(vi) + 1, 1.0);
+    m_scale[static_cast<size_t>(vi)] = s;
 }
 
 double EdgeSizing::scale(int a, int b) const {

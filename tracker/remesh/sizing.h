@@ -46,12 +46,16 @@ std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
 /// whose outer triangles are slivers (A4 with thin-sheet sizing: minimum angles of 0.1°).
 constexpr double SIZE_GRADING = 0.5;
 
-/// Edge-length limits for one pass over the mesh. The curvature is measured when the object is
-/// built; vertices created afterwards get the nominal limits (s = 1) until the next pass.
+/// Edge-length limits for one split or collapse call. Curvature and facing distances are
+/// measured when the object is built; vertices created afterwards get the nominal limits
+/// (s = 1) unless inherit() grades them from their split edge's endpoints.
 class EdgeSizing {
 public:
     /// Throws std::invalid_argument on invalid options or ξ ≤ 0.
     EdgeSizing(const SurfaceMesh& mesh, const RemeshOptions& options, double xi);
+    /// Gives vertex vi, created by splitting the edge (a, b) after the measurement, the graded
+    /// bound of its endpoints' target lengths, so that refinement continues within the call.
+    void inherit(const SurfaceMesh& mesh, int vi, int a, int b);
     /// s ∈ [s_min, 1] for the edge between vertices a and b (1 when adaptivity is off).
     double scale(int a, int b) const;
     double max_length(int a, int b) const { return m_limits.max_edge_length * scale(a, b); }

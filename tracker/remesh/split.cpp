@@ -76,10 +76,11 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
         return *hash;
     };
 
+    // α per edge (lower where the surface turns or faces itself, with adaptive sizing),
+    // measured once per call; new vertices are graded from their edge's endpoints. Its ratio to the length orders
+    // the splits.
+    EdgeSizing sizing(mesh, options, context.xi);
     for (int pass = 0; pass < options.max_split_passes; ++pass) {
-        // α per edge (lower where the surface turns, with curvature-adaptive sizing),
-        // measured once per pass; its ratio to the length orders the splits.
-        const EdgeSizing sizing(mesh, options, context.xi);
         struct LongEdge {
             double excess;  ///< length / α
             double alpha;
@@ -142,6 +143,7 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
             if (hash)
                 hash->begin_update(mesh, touched);
             const int vi = mesh.split_edge(ei, midpoint, 0.5);
+            sizing.inherit(mesh, vi, e[0], e[1]);
             touched.push_back(vi);
             if (hash)
                 hash->refresh(mesh, touched);
