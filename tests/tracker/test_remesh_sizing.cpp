@@ -142,6 +142,15 @@ SurfaceMesh make_shell(double thickness) {
     return SurfaceMesh(positions, triangles);
 }
 
+/// Thin-sheet sizing with sag at most a quarter of the thickness, down to s = 0.1.
+RemeshOptions thin_sheet_options() {
+    RemeshOptions options;
+    options.thin_sheet_sag_fraction = 0.25;
+    options.split_on_fitted_surface = true;
+    options.min_curvature_size_fraction = 0.1;
+    return options;
+}
+
 TEST(RemeshSizing, FacingDistanceIsTheSheetThicknessAndSkipsTheSameSide) {
     constexpr double THICKNESS = 0.004;
     const SurfaceMesh shell = make_shell(THICKNESS);
@@ -181,10 +190,7 @@ TEST(RemeshSizing, ThinSheetSizingKeepsTheChordSagBelowAFractionOfTheThickness) 
     constexpr double THICKNESS = 0.004;
     const SurfaceMesh shell = make_shell(THICKNESS);
     const double xi = testing::mean_edge_length(shell);
-    RemeshOptions options;
-    options.thin_sheet_sag_fraction = 0.25;
-    options.split_on_fitted_surface = true;
-    options.min_curvature_size_fraction = 0.1;
+    RemeshOptions options = thin_sheet_options();
     const EdgeSizing sizing(shell, options, xi);
     ASSERT_TRUE(sizing.adaptive());
     const double alpha = sizing.limits().max_edge_length;
@@ -247,10 +253,7 @@ TEST(RemeshSizing, TargetLengthIsGradedAwayFromARefinedSpot) {
             shell.set_position(vi, x * (0.247 / x.norm()));
     }
     const double xi = testing::mean_edge_length(shell);
-    RemeshOptions options;
-    options.thin_sheet_sag_fraction = 0.25;
-    options.split_on_fitted_surface = true;
-    options.min_curvature_size_fraction = 0.1;
+    RemeshOptions options = thin_sheet_options();
     const EdgeSizing sizing(shell, options, xi);
     const double alpha = sizing.limits().max_edge_length;
     int refined = 0, graded = 0;
