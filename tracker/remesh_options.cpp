@@ -29,18 +29,15 @@ void RemeshOptions::validate() const {
             "RemeshOptions::max_edge_fraction", "must be finite and > min_edge_fraction");
     require(finite_positive(max_volume_change_fraction),
             "RemeshOptions::max_volume_change_fraction", "must be finite and > 0");
-    require(std::isfinite(curvature_edge_fraction) && curvature_edge_fraction >= 0.0,
-            "RemeshOptions::curvature_edge_fraction", "must be finite and >= 0");
-    require(curvature_edge_fraction == 0.0 || split_on_fitted_surface,
-            "RemeshOptions::curvature_edge_fraction",
-            "> 0 needs split_on_fitted_surface (butterfly points on graded meshes add bumps "
-            "that the curvature estimate then refines without end)");
-    require(std::isfinite(thin_sheet_sag_fraction) && thin_sheet_sag_fraction >= 0.0,
-            "RemeshOptions::thin_sheet_sag_fraction", "must be finite and >= 0");
-    require(thin_sheet_sag_fraction == 0.0 || split_on_fitted_surface,
-            "RemeshOptions::thin_sheet_sag_fraction",
-            "> 0 needs split_on_fitted_surface (butterfly points on graded meshes add bumps "
-            "that the curvature estimate then refines without end)");
+    // Adaptive sizing terms: ≥ 0, and > 0 only with fitted split points.
+    const auto adaptive_term = [this](double value, const char* field) {
+        require(std::isfinite(value) && value >= 0.0, field, "must be finite and >= 0");
+        require(value == 0.0 || split_on_fitted_surface, field,
+                "> 0 needs split_on_fitted_surface (butterfly points on graded meshes add "
+                "bumps that the curvature estimate then refines without end)");
+    };
+    adaptive_term(curvature_edge_fraction, "RemeshOptions::curvature_edge_fraction");
+    adaptive_term(thin_sheet_sag_fraction, "RemeshOptions::thin_sheet_sag_fraction");
     require(std::isfinite(min_curvature_size_fraction) && min_curvature_size_fraction > 0.0 &&
                 min_curvature_size_fraction <= 1.0,
             "RemeshOptions::min_curvature_size_fraction", "must be in (0, 1]");
