@@ -446,6 +446,27 @@ void LooseGrid::visit(size_t task, F&& f) const {
     // An oversized element against every other element (two oversized ones once).
     const int io = m_oversized[task - m_cells.size()];
     const Box3d& box_o = m_boxes[static_cast<size_t>(io)];
+    // The others through the cells that can hold an overlapping element: its min corner lies
+    // within one cell below box_o (it is at most one cell wide), as in query().
+    const Eigen::Array3d lo_d = ((box_o.min().array() - m_cell) / m_cell).floor();
+    const Eigen::Array3d hi_d = (box_o.max().array() / m_cell).floor();
+    const double limit = (1 << 20) - 2;
+    if (((hi_d - lo_d) + 1.0).prod() <= static_cast<double>(MAX_CELLS_PER_BOX) &&
+        (lo_d.abs() <= limit).all() && (hi_d.abs() <= limit).all()) {
+        const Eigen::Array3i lo = lo_d.cast<int>(), hi = hi_d.cast<int>();
+        for (int z = lo.z(); z <= hi.z(); ++z)
+            for (int y = lo.y(); y <= hi.y(); ++y)
+                for (int x = lo.x(); x <= hi.x(); ++x) {
+                    const auto [begin, end] = find_cell(cell_key(Eigen::Array3i(x, y, z)));
+                    for (int k = begin; k < end; ++k)
+                        if (boxes_overlap(box_o, m_cell_boxes[static_cast<size_t>(k)]))
+                            f(io, m_ids[static_cast<size_t>(k)]);
+                }
+        for (int jo : m_oversized)
+            if (jo > io && boxes_overlap(box_o, m_boxes[static_cast<size_t>(jo)]))
+                f(io, jo);
+        return;
+    }
     for (size_t j = 0; j < m_boxes.size(); ++j) {
         const int ij = static_cast<int>(j);
         if (ij == io || m_boxes[j].isEmpty() || !boxes_overlap(box_o, m_boxes[j]))

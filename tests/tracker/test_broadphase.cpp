@@ -116,6 +116,42 @@ TEST(SpatialHash, RandomUpdatesMatchBruteForce) {
     }
 }
 
+// The loose grid's self join finds every overlapping pair exactly once, also for oversized
+// elements (wider than a cell: found through the cells they cover, or by a scan when they
+// cover too many) among ordinary ones. Graded meshes (A4 with thin-sheet sizing) have many
+// edges a little wider than the cell. Here: separate random triangles of mixed sizes.
+TEST(BroadPhaseTrianglePairs, EqualBruteForceWithOversizedTriangles) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> pos(-2.0, 2.0), size(-0.1, 0.1), coin(0.0, 1.0);
+    std::vector<Vec3> positions;
+    std::vector<Triangle> triangles;
+    for (int k = 0; k < 600; ++k) {
+        const double u = coin(rng);
+        const double scale = u < 0.03 ? 40.0 : u < 0.25 ? 3.0 : 1.0;  // huge, oversized, ordinary
+        const Vec3 a(pos(rng), pos(rng), pos(rng));
+        const int base = static_cast<int>(positions.size());
+        positions.push_back(a);
+        positions.push_back(a + scale * Vec3(size(rng), size(rng), size(rng)));
+        positions.push_back(a + scale * Vec3(size(rng), size(rng), size(rng)));
+        triangles.push_back({base, base + 1, base + 2});
+    }
+    const SurfaceMesh m(positions, triangles);
+    const BroadPhase broad(m, 0.0);
+    const std::vector<TrianglePair> found = broad.triangle_pairs();
+    std::vector<TrianglePair> expected;
+    const auto box = [&](int t) {
+        Box3d b;
+        for (int vi : m.triangle(t))
+            b.extend(m.position(vi));
+        return b;
+    };
+    for (int ti = 0; ti < m.num_triangles(); ++ti)
+        for (int tj = ti + 1; tj < m.num_triangles(); ++tj)
+            if (box(ti).intersects(box(tj)))
+                expected.push_back({ti, tj});
+    EXPECT_EQ(found, expected);
+}
+
 // Triangle pairs of the static broad phase equal brute force (self join over one grid).
 TEST(BroadPhaseTrianglePairs, EqualBruteForce) {
     const SurfaceMesh m = meshed(
