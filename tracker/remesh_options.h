@@ -25,10 +25,11 @@ struct RemeshOptions {
     /// turns with curvature κ, so edges there turn by at most about c radians (a neck of radius
     /// r keeps about 2π/c edges around it). 0 (the default) keeps α and β everywhere; ≥ 0.
     /// Experimental, used by no scene or validation case: on the A2 dumbbell at ξ = 0.04
-    /// (c = 0.5, s_min = 0.125) L∞ fell from 2.4e-3 to 1.6e-3 and the pinch-off came 6e-4 s
-    /// earlier, nearer the reference; but at ξ = 0.02 the run stalled at the pinch (t = 0.01595:
-    /// collision resolution found no admissible motion at edges of ξ/16), and with s_min =
-    /// 1/16 at ξ = 0.04 one run built an impact zone too large for memory (hence
+    /// (c = 0.5, s_min = 0.125, graded target lengths) L∞ fell from 2.4e-3 to 1.45e-3 and the
+    /// pinch-off came 6e-4 s earlier, nearer the reference; at ξ = 0.02 L∞ stayed at 5.9e-4
+    /// (L1 6.4e-5 against 6.6e-5) for twice the time (778 s against 383 s). Before the grading
+    /// the ξ = 0.02 run stalled at the pinch (t = 0.01595), and with s_min = 1/16 at ξ = 0.04
+    /// one run built an impact zone too large for memory (hence
     /// CollisionOptions::max_zone_matrix_entries), then spent over 10 minutes in one step.
     /// Needs split_on_fitted_surface: butterfly points on the irregular stencils of a graded
     /// mesh leave bumps, the curvature estimate sees them and refines further, without end
