@@ -75,11 +75,7 @@ std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
     if (normals.size() != n || radius.size() != n)
         throw std::invalid_argument("vertex_facing_distance: one normal and radius per vertex");
     std::vector<double> distance(n, std::numeric_limits<double>::infinity());
-    double largest = 0.0;
-    for (size_t vi = 0; vi < n; ++vi)
-        if (radius[vi] > 0.0 && std::isfinite(radius[vi]))
-            largest = std::max(largest, radius[vi]);
-    if (!(largest > 0.0))
+    if (std::none_of(radius.begin(), radius.end(), [](double r) { return r > 0.0; }))
         return distance;
     // Triangles by box, with their unit normals; hash cells as large as the mean box.
     std::vector<Vec3> triangle_normal(static_cast<size_t>(mesh.num_triangles()), Vec3::Zero());
@@ -104,11 +100,11 @@ std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
     }
     if (counted == 0)
         return distance;
-    SpatialHash triangles(extent_sum / counted);
+    const double mean_extent = extent_sum / counted;
+    SpatialHash triangles(mean_extent);
     for (int ti = 0; ti < mesh.num_triangles(); ++ti)
         if (!triangle_normal[static_cast<size_t>(ti)].isZero())
             triangles.insert(ti, boxes[static_cast<size_t>(ti)]);
-    const double near = extent_sum / counted;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
         std::vector<int> candidates;
         for (size_t vi = r.begin(); vi != r.end(); ++vi) {
@@ -143,7 +139,7 @@ std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
                 }
                 return found ? best : std::numeric_limits<double>::infinity();
             };
-            const double first = std::min(near, radius[vi]);
+            const double first = std::min(mean_extent, radius[vi]);
             double d = nearest(first);
             if (!std::isfinite(d) && radius[vi] > first)
                 d = nearest(radius[vi]);
@@ -193,24 +189,28 @@ EdgeSizing::EdgeSizing(const SurfaceMesh& mesh, const RemeshOptions& options, do
 
 void EdgeSizing::grade(const SurfaceMesh& mesh) {
     // Dijkstra over the edge graph on the target length H = s α: H_v ≤ H_w + g |x_v − x_w|.
+    // H is kept apart from s so that the stale-entry test compares the very values queued.
     const double alpha = m_limits.max_edge_length;
+    std::vector<double> target(m_scale.size());
+    for (size_t vi = 0; vi < m_scale.size(); ++vi)
+        target[vi] = m_scale[vi] * alpha;
     using Item = std::pair<double, int>;  // (H, vertex)
     std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
     for (size_t vi = 0; vi < m_scale.size(); ++vi)
         if (m_scale[vi] < 1.0 && mesh.vertex_alive(static_cast<int>(vi)))
-            queue.emplace(m_scale[vi] * alpha, static_cast<int>(vi));
+            queue.emplace(target[vi], static_cast<int>(vi));
     while (!queue.empty()) {
         const auto [h, vi] = queue.top();
         queue.pop();
-        if (h > m_scale[static_cast<size_t>(vi)] * alpha)
+        if (h > target[static_cast<size_t>(vi)])
             continue;  // stale entry
         for (int ei : mesh.vertex_edges(vi)) {
             const int wi = mesh.other_vertex(ei, vi);
             const double reach =
                 h + SIZE_GRADING * (mesh.position(wi) - mesh.position(vi)).norm();
-            double& sw = m_scale[static_cast<size_t>(wi)];
-            if (reach < sw * alpha) {
-                sw = reach / alpha;
+            if (reach < target[static_cast<size_t>(wi)]) {
+                target[static_cast<size_t>(wi)] = reach;
+                m_scale[static_cast<size_t>(wi)] = reach / alpha;
                 queue.emplace(reach, wi);
             }
         }
