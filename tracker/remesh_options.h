@@ -46,8 +46,8 @@ struct RemeshOptions {
     /// discretized sides of a sheet thinner than their chord sag meet and are then held apart
     /// by collision handling while the flow stretches them (A4's volume gain). 0 (the default)
     /// turns it off; ≥ 0. Experimental. Needs split_on_fitted_surface, like
-    /// curvature_edge_fraction. A4 at ξ = 0.04 with f = 1.5 and s_min = 0.5: volume +2.74 %
-    /// at t = 25 on 137k triangles, against +9.94 % on 41k with uniform sizing (and +2.88 % at
+    /// curvature_edge_fraction. A4 at ξ = 0.04 with f = 1.5 and s_min = 0.5: volume +2.47 %
+    /// at t = 25 on 138k triangles, against +9.90 % on 40k with uniform sizing (and +2.88 % at
     /// t = 24.45 on 226k with uniform sizing at ξ = 0.02).
     double thin_sheet_sag_fraction = 0.0;
 
