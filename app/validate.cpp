@@ -59,6 +59,13 @@ struct PhaseSeconds {
     double verification = 0.0;  ///< the exact static intersection test (not a paper phase)
 };
 
+/// Where the enclosed volume changed (m³, summed over steps): mesh improvement and topology
+/// changes; the flow's motion as requested (shortened by the fraction collision handling
+/// applied); and what collision handling changed of that motion.
+struct VolumeBudget {
+    double remeshing = 0.0, motion = 0.0, collisions = 0.0;
+};
+
 struct RunSpec {
     std::string case_id;  ///< "A1", …
     std::string label;    ///< e.g. "face offsetting"
@@ -80,6 +87,7 @@ struct RunResult {
     std::string stop_reason;
     double initial_volume = 0.0;
     PhaseSeconds seconds;
+    VolumeBudget volume_budget;
     int min_triangles = 0, max_triangles = 0;
     int max_intersecting_pairs = 0;
     int steps_with_intersections = 0;
@@ -133,19 +141,29 @@ RunResult run_tracked(const RunSpec& spec, bool quiet) {
         }
         const double next_stop = *std::upper_bound(stops.begin(), stops.end(), r.t);
         const double offered = std::min(spec.max_dt, next_stop - r.t);
+        const double volume_before = tracker::enclosed_volume(mesh);
         auto start = Clock::now();
         tr.improve();
         r.seconds.improvement += seconds_since(start);
         start = Clock::now();
         tr.change_topology();  // compacts
         r.seconds.topology += seconds_since(start);
+        const double volume_remeshed = tracker::enclosed_volume(mesh);
+        r.volume_budget.remeshing += volume_remeshed - volume_before;
         start = Clock::now();
         const tracker::FlowStep step = spec.stepper->step(mesh, r.t, offered);
         const std::vector<Vec3> velocities = as_velocities(step.displacements, step.dt);
         r.seconds.set_velocity += seconds_since(start);
+        const std::vector<Vec3> x0 = mesh.positions();
         start = Clock::now();
         const tracker::IntegrateResult integrated = tr.integrate(velocities, step.dt);
         r.seconds.collisions += seconds_since(start);
+        std::vector<Vec3> requested = x0;
+        for (size_t i = 0; i < requested.size(); ++i)
+            requested[i] += integrated.collisions.motion_fraction * step.displacements[i];
+        const double volume_requested = tracker::enclosed_volume(mesh, requested);
+        r.volume_budget.motion += volume_requested - volume_remeshed;
+        r.volume_budget.collisions += tracker::enclosed_volume(mesh) - volume_requested;
         start = Clock::now();
         const int pairs =
             static_cast<int>(tracker::find_self_intersections(mesh).triangle_pairs.size());
@@ -235,6 +253,10 @@ Json run_json(const RunResult& r) {
              100.0 * tracker::relative_volume_change(r.initial_volume, r.series_volume.back())},
             {"final_components", r.series_components.back()},
             {"seconds_per_step", phase_json(r.seconds, r.steps)},
+            {"volume_change_percent_by_phase",
+             {{"remeshing", 100.0 * r.volume_budget.remeshing / r.initial_volume},
+              {"motion", 100.0 * r.volume_budget.motion / r.initial_volume},
+              {"collisions", 100.0 * r.volume_budget.collisions / r.initial_volume}}},
             {"wall_seconds", r.wall_seconds},
             {"series",
              {{"t", r.series_t},

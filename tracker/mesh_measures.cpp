@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace meniscus::tracker {
 
@@ -16,23 +18,30 @@ double tet6(const Vec3& ref, const Vec3& a, const Vec3& b, const Vec3& c) {
     return (a - ref).dot((b - ref).cross(c - ref));
 }
 
-Vec3 reference_point(const SurfaceMesh& mesh) {
+Vec3 reference_point(const SurfaceMesh& mesh, const std::vector<Vec3>& positions) {
     for (int vi = 0; vi < mesh.num_vertices(); ++vi)
         if (mesh.vertex_alive(vi))
-            return mesh.position(vi);
+            return positions[static_cast<size_t>(vi)];
     return Vec3::Zero();
 }
 
 }  // namespace
 
-double enclosed_volume(const SurfaceMesh& mesh) {
-    const Vec3 ref = reference_point(mesh);
+double enclosed_volume(const SurfaceMesh& mesh) { return enclosed_volume(mesh, mesh.positions()); }
+
+double enclosed_volume(const SurfaceMesh& mesh, const std::vector<Vec3>& positions) {
+    if (positions.size() != static_cast<size_t>(mesh.num_vertices()))
+        throw std::invalid_argument("enclosed_volume: " + std::to_string(positions.size()) +
+                                    " positions for " + std::to_string(mesh.num_vertices()) +
+                                    " vertex slots");
+    const Vec3 ref = reference_point(mesh, positions);
+    const auto x = [&](int vi) -> const Vec3& { return positions[static_cast<size_t>(vi)]; };
     double six_v = 0.0;
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
         if (!mesh.triangle_alive(ti))
             continue;
         const Triangle& t = mesh.triangle(ti);
-        six_v += tet6(ref, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+        six_v += tet6(ref, x(t[0]), x(t[1]), x(t[2]));
     }
     return six_v / 6.0;
 }
@@ -116,7 +125,7 @@ Components triangle_components(const SurfaceMesh& mesh) {
 
 std::vector<double> component_volumes(const SurfaceMesh& mesh, const Components& components) {
     std::vector<double> six_v(static_cast<size_t>(components.count), 0.0);
-    const Vec3 ref = reference_point(mesh);
+    const Vec3 ref = reference_point(mesh, mesh.positions());
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
         if (!mesh.triangle_alive(ti))
             continue;

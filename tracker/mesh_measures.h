@@ -11,6 +11,9 @@ namespace meniscus::tracker {
 /// Signed volume enclosed by the live triangles (divergence theorem; positive when normals
 /// point outward of the enclosed region). Meaningful for closed surfaces; units: length³.
 double enclosed_volume(const SurfaceMesh& mesh);
+/// The same with the vertices at `positions` (sized mesh.num_vertices(); throws
+/// std::invalid_argument otherwise): the volume a motion would give, without moving the mesh.
+double enclosed_volume(const SurfaceMesh& mesh, const std::vector<Vec3>& positions);
 /// Total area of live triangles (length²).
 double surface_area(const SurfaceMesh& mesh);
 

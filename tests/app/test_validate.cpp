@@ -182,6 +182,19 @@ TEST_F(QuickValidation, EnrightQuickConservesVolumeAndReturns) {
     EXPECT_LT(s[0]["error_to_initial_sphere"]["linf"].get<double>(), ENRIGHT_QUICK_RETURN_LINF);
 }
 
+TEST_F(QuickValidation, VolumeChangeByPhaseSumsToTheVolumeChange) {
+    for (const Json& r : s_results["runs"]) {
+        SCOPED_TRACE(r["case"].get<std::string>() + " " + r["label"].get<std::string>());
+        const Json& b = r["volume_change_percent_by_phase"];
+        const double sum = b["remeshing"].get<double>() + b["motion"].get<double>() +
+                           b["collisions"].get<double>();
+        EXPECT_NEAR(sum, r["volume_change_percent"].get<double>(), 1e-9);
+        if (!r["collision_safety"].get<bool>()) {  // nothing changed but v · Δt's rounding
+            EXPECT_NEAR(b["collisions"].get<double>(), 0.0, 1e-9);
+        }
+    }
+}
+
 TEST_F(QuickValidation, ReportHasEveryCaseTable) {
     ASSERT_TRUE(fs::exists(s_out / "report.md"));
     for (const char* heading : {"## A1", "## A2", "## A3", "## A4", "## A5"})

@@ -40,6 +40,17 @@ TEST(SurfaceMesh, BuildsAdjacency) {
     EXPECT_EQ(euler_characteristic(m), 2);
 }
 
+TEST(SurfaceMesh, EnclosedVolumeAtOtherPositionsLeavesTheMeshAlone) {
+    const SurfaceMesh m = octahedron();  // volume 4/3
+    std::vector<Vec3> scaled = m.positions();
+    for (Vec3& x : scaled)
+        x = 2.0 * x + Vec3(5, -3, 1);  // volume × 8, wherever it is
+    EXPECT_NEAR(enclosed_volume(m, scaled), 8.0 * 4.0 / 3.0, 1e-13);
+    EXPECT_NEAR(enclosed_volume(m), 4.0 / 3.0, 1e-14);
+    scaled.pop_back();
+    EXPECT_THROW(enclosed_volume(m, scaled), std::invalid_argument);
+}
+
 TEST(SurfaceMesh, RejectsBadTriangles) {
     EXPECT_THROW(SurfaceMesh({{0, 0, 0}, {1, 0, 0}}, {{0, 1, 2}}), std::invalid_argument);
     EXPECT_THROW(SurfaceMesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 1}}),
