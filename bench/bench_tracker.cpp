@@ -1,9 +1,13 @@
 // Broad phase, static intersection check and a whole collision-safe integrate() step at
-// 10k, 50k and 200k triangles (issue 3). Meshes: spheres meshed at an edge length chosen for
+// 10k, 50k and 200k triangles (issue 3), and collision resolution on A4 curl-noise states. Meshes: spheres meshed at an edge length chosen for
 // the triangle count; motion: a smooth swirl plus a random jitter of 5 % of an edge per step.
 #include "tracker/broadphase.h"
+#include "tracker/collision_resolution.h"
+#include "tracker/flows/curl_noise.h"
+#include "tracker/flows/flow_runner.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/mesh_intersections.h"
+#include "tracker/mesh_io.h"
 #include "tracker/surface_tracker.h"
 
 #include <benchmark/benchmark.h>
@@ -11,6 +15,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <string>
 
 namespace {
 
@@ -126,6 +131,37 @@ void BM_IntegrateCrushed(benchmark::State& state) {
         benchmark::Counter(collisions, benchmark::Counter::kAvgIterations);
 }
 
+/// Contact-heavy, from a real run: one collision resolution of A4 curl noise (ξ = 0.04, validate's
+/// field) on thin sheets pressed together, from the states kept for the collision regression
+/// tests (tests/data/regression): t = 27.2 (54 914 triangles, where an active-set impact-zone
+/// solve cycled and halved the step twice) and t = 28.1 (44 794 triangles).
+void BM_ResolveCurlNoiseSheets(benchmark::State& state, const char* file, double t) {
+    const SurfaceMesh mesh = to_surface_mesh(
+        read_ply(std::string(MENISCUS_TEST_DATA_DIR) + "/regression/" + file), file);
+    CurlNoiseOptions noise;
+    noise.planar = true;
+    noise.rms_speed = 0.05;
+    noise.base_wavelength = 0.5;
+    noise.time_frequency = 1.0;
+    const CurlNoiseField field(noise);
+    const FlowStep step = VelocityFieldStepper(field).step(mesh, t, 0.05);
+    std::vector<Vec3> requested = mesh.positions();
+    for (size_t i = 0; i < requested.size(); ++i)
+        requested[i] += step.displacements[i];
+    CollisionOptions options;
+    options.proximity_epsilon = TrackerOptions{}.proximity_fraction * 0.040977574596089125;
+    CollisionReport report;
+    for (auto _ : state) {
+        std::vector<Vec3> x1 = requested;
+        report = resolve_collisions(mesh, mesh.positions(), x1, step.dt, options);
+        benchmark::DoNotOptimize(x1.data());
+    }
+    state.counters["triangles"] = mesh.count_live_triangles();
+    state.counters["first_sweep_hits"] = report.collisions_first_sweep;
+    state.counters["impact_zone_rounds"] = report.impact_zone_iterations;
+    state.counters["step_shortenings"] = report.step_shortenings;
+}
+
 // Integrate steps evolve the mesh, so later steps differ from earlier ones: a fixed iteration
 // count makes runs comparable.
 BENCHMARK(BM_Integrate)
@@ -135,6 +171,12 @@ BENCHMARK(BM_Integrate)
     ->Iterations(20)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_IntegrateCrushed)->Arg(2000)->Arg(10000)->Iterations(40)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ResolveCurlNoiseSheets, t27_2, "curl_noise_a4_t27.2.ply", 27.200000000000003)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ResolveCurlNoiseSheets, t28_1, "curl_noise_a4_t28.1.ply", 28.100000000000264)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 

@@ -7,11 +7,11 @@
 /// ε_p at t0; (2) up to `impulse_sweeps` sweeps of CCD with per-collision inelastic impulses;
 /// (3) impact zones: colliding elements grouped by shared vertices and solved together,
 /// minimizing ‖u′ − u‖_M subject to each collision's relative normal displacement reaching
-/// its small separating target (an inequality; active set of equalities C M⁻¹ Cᵀ λ = b − C u,
-/// λ ≥ 0), zones merging as new collisions appear, until none remains; (4) bounded
-/// fallbacks: rigid impact zones (each zone moves as a rigid body), then shortening the step
-/// (x_t1 pulled back towards x_t0), then — if still not free — no motion at all. Every loop has a
-/// bound; what was used is reported. Never prints, never loops forever.
+/// its small separating target (an inequality: the dual, min ½λᵀ(C M⁻¹ Cᵀ)λ − λᵀ(b − C u) over
+/// λ ≥ 0, by projected Gauss–Seidel), zones merging as new collisions appear, until none
+/// remains; (4) bounded fallbacks: rigid impact zones (each zone moves as a rigid body), then
+/// shortening the step (x_t1 pulled back towards x_t0), then — if still not free — no motion at
+/// all. Every loop has a bound; what was used is reported. Never prints, never loops forever.
 
 #include "tracker/mesh.h"
 
