@@ -378,12 +378,13 @@ bool trajectory_less(const Eigen::Vector3d& a0, const Eigen::Vector3d& a1,
 }
 
 void require_finite(std::initializer_list<const Eigen::Vector3d*> points, const char* query) {
-    for (const Eigen::Vector3d* p : points) {
-        if (!p->allFinite()) {
-            throw std::invalid_argument(std::string(query) +
-                                        ": non-finite vertex position; pass finite positions");
-        }
-    }
+    // x · 0 is 0 for finite x and NaN for ±∞ and NaN: one branch for all coordinates.
+    double zero = 0.0;
+    for (const Eigen::Vector3d* p : points)
+        zero += (*p)[0] * 0.0 + (*p)[1] * 0.0 + (*p)[2] * 0.0;
+    if (zero != 0.0)
+        throw std::invalid_argument(std::string(query) +
+                                    ": non-finite vertex position; pass finite positions");
 }
 
 /// Sound early exit: true when some plane strictly separates the convex hulls of the two

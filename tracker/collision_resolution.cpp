@@ -62,6 +62,30 @@ constexpr double CANDIDATE_SLACK_GROWTH = 4.0;
 constexpr double CANDIDATE_SLACK_CAP = 0.25;
 constexpr double CANDIDATE_SLACK_EDGE_CAP = 0.05;
 
+/// Items per task of ordered_parallel_collect.
+constexpr size_t COLLECT_CHUNK = 4096;
+
+/// What `visit(i, out)` appends for i = 0 … n − 1, in the order of i, computed in parallel
+/// chunks: the result is the serial loop's, whatever the thread count.
+template <typename T, typename Visit>
+std::vector<T> ordered_parallel_collect(size_t n, const Visit& visit) {
+    const size_t chunks = (n + COLLECT_CHUNK - 1) / COLLECT_CHUNK;
+    std::vector<std::vector<T>> parts(chunks);
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t k) {
+        const size_t end = std::min(n, (k + 1) * COLLECT_CHUNK);
+        for (size_t i = k * COLLECT_CHUNK; i < end; ++i)
+            visit(i, parts[k]);
+    });
+    size_t total = 0;
+    for (const std::vector<T>& part : parts)
+        total += part.size();
+    std::vector<T> out;
+    out.reserve(total);
+    for (const std::vector<T>& part : parts)
+        out.insert(out.end(), part.begin(), part.end());
+    return out;
+}
+
 /// One possible contact between four vertices with weights ā (Σ āᵢ xᵢ = separation vector) and
 /// a unit normal n: the constraint row is āᵢ nᵀ per vertex.
 struct Contact {
@@ -147,30 +171,37 @@ public:
         const double padding = 0.5 * m_o.proximity_epsilon;
         m_candidates = build_candidates(d, padding + CANDIDATE_SLACK_FRACTION * m_o.proximity_epsilon);
         m_detected_d.clear();
-        std::vector<Contact> contacts;
-        for (const VertexTrianglePair& p : m_candidates.vertex_triangle) {
-            const Triangle& t = m_mesh.triangle(p.ti);
-            if (!boxes_overlap(static_box({p.vi}, padding), static_box({t[0], t[1], t[2]}, padding)))
-                continue;
-            const auto prox = point_triangle_proximity(x0(p.vi), x0(t[0]), x0(t[1]), x0(t[2]));
-            if (prox.distance < m_o.proximity_epsilon)
-                contacts.push_back({{p.vi, t[0], t[1], t[2]},
-                                    prox.weights,
-                                    prox.normal,
-                                    m_o.proximity_epsilon - prox.distance});
-        }
-        for (const EdgeEdgePair& p : m_candidates.edge_edge) {
-            const Edge& a = m_mesh.edge(p.ei);
-            const Edge& b = m_mesh.edge(p.ej);
-            if (!boxes_overlap(static_box({a[0], a[1]}, padding), static_box({b[0], b[1]}, padding)))
-                continue;
-            const auto prox = edge_edge_proximity(x0(a[0]), x0(a[1]), x0(b[0]), x0(b[1]));
-            if (prox.distance < m_o.proximity_epsilon)
-                contacts.push_back({{a[0], a[1], b[0], b[1]},
-                                    prox.weights,
-                                    prox.normal,
-                                    m_o.proximity_epsilon - prox.distance});
-        }
+        const size_t vt_count = m_candidates.vertex_triangle.size();
+        const std::vector<Contact> contacts = ordered_parallel_collect<Contact>(
+            vt_count + m_candidates.edge_edge.size(), [&](size_t i, std::vector<Contact>& out) {
+                if (i < vt_count) {
+                    const VertexTrianglePair& p = m_candidates.vertex_triangle[i];
+                    const Triangle& t = m_mesh.triangle(p.ti);
+                    if (!boxes_overlap(static_box({p.vi}, padding),
+                                       static_box({t[0], t[1], t[2]}, padding)))
+                        return;
+                    const auto prox =
+                        point_triangle_proximity(x0(p.vi), x0(t[0]), x0(t[1]), x0(t[2]));
+                    if (prox.distance < m_o.proximity_epsilon)
+                        out.push_back({{p.vi, t[0], t[1], t[2]},
+                                       prox.weights,
+                                       prox.normal,
+                                       m_o.proximity_epsilon - prox.distance});
+                } else {
+                    const EdgeEdgePair& p = m_candidates.edge_edge[i - vt_count];
+                    const Edge& a = m_mesh.edge(p.ei);
+                    const Edge& b = m_mesh.edge(p.ej);
+                    if (!boxes_overlap(static_box({a[0], a[1]}, padding),
+                                       static_box({b[0], b[1]}, padding)))
+                        return;
+                    const auto prox = edge_edge_proximity(x0(a[0]), x0(a[1]), x0(b[0]), x0(b[1]));
+                    if (prox.distance < m_o.proximity_epsilon)
+                        out.push_back({{a[0], a[1], b[0], b[1]},
+                                       prox.weights,
+                                       prox.normal,
+                                       m_o.proximity_epsilon - prox.distance});
+                }
+            });
         for (const Contact& c : contacts)
             apply_impulse(c, m_inv_mass, d);
         return static_cast<int>(contacts.size());
@@ -379,26 +410,28 @@ private:
     /// the same (sorted) order.
     std::vector<VertexTrianglePair> filter_vertex_triangle(
         const std::vector<Vec3>& x1, const std::vector<std::uint8_t>& changed) const {
-        std::vector<VertexTrianglePair> out;
-        for (const VertexTrianglePair& p : m_candidates.vertex_triangle) {
-            const Triangle& t = m_mesh.triangle(p.ti);
-            if (any_changed(changed, {p.vi, t[0], t[1], t[2]}) &&
-                boxes_overlap(moving_box({p.vi}, x1), moving_box({t[0], t[1], t[2]}, x1)))
-                out.push_back(p);
-        }
-        return out;
+        const std::vector<VertexTrianglePair>& all = m_candidates.vertex_triangle;
+        return ordered_parallel_collect<VertexTrianglePair>(
+            all.size(), [&](size_t i, std::vector<VertexTrianglePair>& out) {
+                const VertexTrianglePair& p = all[i];
+                const Triangle& t = m_mesh.triangle(p.ti);
+                if (any_changed(changed, {p.vi, t[0], t[1], t[2]}) &&
+                    boxes_overlap(moving_box({p.vi}, x1), moving_box({t[0], t[1], t[2]}, x1)))
+                    out.push_back(p);
+            });
     }
     std::vector<EdgeEdgePair> filter_edge_edge(const std::vector<Vec3>& x1,
                                                const std::vector<std::uint8_t>& changed) const {
-        std::vector<EdgeEdgePair> out;
-        for (const EdgeEdgePair& p : m_candidates.edge_edge) {
-            const Edge& a = m_mesh.edge(p.ei);
-            const Edge& b = m_mesh.edge(p.ej);
-            if (any_changed(changed, {a[0], a[1], b[0], b[1]}) &&
-                boxes_overlap(moving_box({a[0], a[1]}, x1), moving_box({b[0], b[1]}, x1)))
-                out.push_back(p);
-        }
-        return out;
+        const std::vector<EdgeEdgePair>& all = m_candidates.edge_edge;
+        return ordered_parallel_collect<EdgeEdgePair>(
+            all.size(), [&](size_t i, std::vector<EdgeEdgePair>& out) {
+                const EdgeEdgePair& p = all[i];
+                const Edge& a = m_mesh.edge(p.ei);
+                const Edge& b = m_mesh.edge(p.ej);
+                if (any_changed(changed, {a[0], a[1], b[0], b[1]}) &&
+                    boxes_overlap(moving_box({a[0], a[1]}, x1), moving_box({b[0], b[1]}, x1)))
+                    out.push_back(p);
+            });
     }
 
     void test(const std::array<int, 4>& v, const std::vector<Vec3>& x1, bool edge_edge,
