@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -303,6 +304,12 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
     // β (and the α no new edge may exceed) per edge, lower where the surface turns or faces
     // itself with adaptive sizing; measured once per call (a collapse keeps one endpoint).
     const EdgeSizing sizing(mesh, options, context.xi);
+    // Vertices of the stars the last pass's collapses changed. Every check of a collapse reads
+    // only the stars of the edge's endpoints (and, for collisions, what is near them), so a
+    // short edge refused in one pass is tried again in the next only when an endpoint's star
+    // changed; a refusal that something farther away might lift waits for the next step.
+    // Empty: every short edge is tried (the first pass).
+    std::vector<std::uint8_t> dirty;
     for (int pass = 0; pass < options.max_collapse_passes; ++pass) {
         struct ShortEdge {
             double fraction;  ///< length / β
@@ -314,6 +321,9 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
             if (!mesh.edge_alive(ei))
                 continue;
             const Edge& e = mesh.edge(ei);
+            if (!dirty.empty() && !dirty[static_cast<size_t>(e[0])] &&
+                !dirty[static_cast<size_t>(e[1])])
+                continue;
             const double scale = sizing.scale(e[0], e[1]);
             const double length = edge_length(mesh, ei);
             if (length < limits.min_edge_length * scale)
@@ -325,6 +335,7 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
         std::sort(short_edges.begin(), short_edges.end(),
                   [](const ShortEdge& a, const ShortEdge& b) { return a.fraction < b.fraction; });
         int collapses_this_pass = 0;
+        std::vector<std::uint8_t> changed(static_cast<size_t>(mesh.num_vertices()), 0);
         for (const auto& [fraction, scale, e] : short_edges) {
             const int ei = mesh.find_edge(e[0], e[1]);
             if (ei == INVALID_INDEX || edge_length(mesh, ei) >= limits.min_edge_length * scale)
@@ -389,6 +400,8 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
                 for (int vi : mesh.triangle(ti))
                     touched.push_back(vi);
             sort_unique(touched);
+            for (int vi : touched)
+                changed[static_cast<size_t>(vi)] = 1;
             if (hash)
                 hash->begin_update(mesh, touched);
             mesh.collapse_edge(ei, plan.kept, plan.position, edge_parameter(mesh, plan));
@@ -401,6 +414,7 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
         }
         if (collapses_this_pass == 0)
             break;
+        dirty = std::move(changed);
     }
     report.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
