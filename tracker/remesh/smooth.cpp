@@ -54,6 +54,15 @@ void hold_colliding_vertices(const SurfaceMesh& mesh, const std::vector<Vec3>& x
     const BroadPhase broad(mesh, x_t0, x_t1, 0.0);
     const std::vector<VertexTrianglePair> vt = broad.vertex_triangle_pairs();
     const std::vector<EdgeEdgePair> ee = broad.edge_edge_pairs();
+    // Vertices held in the last round (empty: the first round, which tests every pair). A pair
+    // without one kept its trajectories, so its last answer — no collision, or its moving
+    // vertices would have been held — still stands.
+    std::vector<std::uint8_t> held_last;
+    const auto retest = [&](const std::array<int, 4>& v) {
+        return held_last.empty() || held_last[static_cast<size_t>(v[0])] ||
+               held_last[static_cast<size_t>(v[1])] || held_last[static_cast<size_t>(v[2])] ||
+               held_last[static_cast<size_t>(v[3])];
+    };
     for (;;) {
         ++report.collision_rounds;
         tbb::enumerable_thread_specific<std::vector<int>> local;
@@ -70,7 +79,8 @@ void hold_colliding_vertices(const SurfaceMesh& mesh, const std::vector<Vec3>& x
                         const Edge& b = mesh.edge(ee[i - vt.size()].ej);
                         v = {a[0], a[1], b[0], b[1]};
                     }
-                    if (!(moving(v[0]) || moving(v[1]) || moving(v[2]) || moving(v[3])))
+                    if (!(moving(v[0]) || moving(v[1]) || moving(v[2]) || moving(v[3])) ||
+                        !retest(v))
                         continue;
                     const auto p0 = [&](int k) -> const Vec3& {
                         return x_t0[static_cast<size_t>(v[k])];
@@ -89,10 +99,12 @@ void hold_colliding_vertices(const SurfaceMesh& mesh, const std::vector<Vec3>& x
                 }
             });
         int held = 0;
+        held_last.assign(x_t0.size(), 0);
         for (const std::vector<int>& part : local)
             for (int vi : part)
                 if (moving(vi)) {
                     x_t1[static_cast<size_t>(vi)] = x_t0[static_cast<size_t>(vi)];
+                    held_last[static_cast<size_t>(vi)] = 1;
                     ++held;
                 }
         report.held_colliding += held;
