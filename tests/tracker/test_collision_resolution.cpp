@@ -268,6 +268,50 @@ TEST(CollisionStress, WithoutSafetyTheSameMotionIntersects) {
     EXPECT_GT(worst, 0);
 }
 
+/// A kept state of the A4 curl-noise run (validate's field, ξ = 0.04, collision safety on):
+/// the mesh after remeshing at time t, and one step's requested motion.
+struct CurlNoiseState {
+    SurfaceMesh mesh;
+    std::vector<Vec3> x0, x1;
+    double dt = 0.0;
+};
+
+CurlNoiseState curl_noise_state(const std::string& file, int triangles, double t) {
+    CurlNoiseState s;
+    s.mesh = to_surface_mesh(read_ply(std::string(MENISCUS_TEST_DATA_DIR) + "/regression/" + file),
+                             file);
+    EXPECT_EQ(s.mesh.count_live_triangles(), triangles);
+    EXPECT_TRUE(find_self_intersections(s.mesh).triangle_pairs.empty());
+    CurlNoiseOptions noise;  // validate's A4 field (app/validate_parameters.h)
+    noise.planar = true;
+    noise.rms_speed = 0.05;
+    noise.base_wavelength = 0.5;
+    noise.time_frequency = 1.0;
+    const CurlNoiseField field(noise);
+    const FlowStep step = VelocityFieldStepper(field).step(s.mesh, t, 0.05);
+    s.x0 = s.mesh.positions();
+    s.x1 = s.x0;
+    for (size_t i = 0; i < s.x1.size(); ++i)
+        s.x1[i] += step.displacements[i];
+    s.dt = step.dt;
+    return s;
+}
+
+/// ξ of the A4 run at ξ = 0.04 (the mean edge of its initial mesh).
+constexpr double CURL_NOISE_XI = 0.040977574596089125;
+
+/// Resolves the state's step with ε_p from `xi`; the motion must end intersection-free.
+CollisionReport resolve_curl_noise_step(const CurlNoiseState& s, double xi) {
+    std::vector<Vec3> x1 = s.x1;
+    CollisionOptions options;
+    options.proximity_epsilon = TrackerOptions{}.proximity_fraction * xi;
+    const CollisionReport r = resolve_collisions(s.mesh, s.x0, x1, s.dt, options);
+    SurfaceMesh moved = s.mesh;
+    moved.set_positions(x1);
+    EXPECT_TRUE(find_self_intersections(moved).triangle_pairs.empty());
+    return r;
+}
+
 // Regression (A4 curl noise, collision safety on, ξ = 0.04): the step at t = 28.1 s has over
 // 500 CCD hits among thin sheets pressed together all over the surface. Impact zones held
 // every contact as an equality; nearly dependent rows with different targets (a pair found
@@ -278,29 +322,11 @@ TEST(CollisionStress, WithoutSafetyTheSameMotionIntersects) {
 // (ε_p from the initial ξ) and the one a tracker built on this mesh uses (its mean edge);
 // replacing repeated rows alone fixed the first but not the second.
 TEST(CollisionRegression, CurlNoiseSheetsAtT28ResolveInAFewImpactZoneRounds) {
-    const SurfaceMesh mesh =
-        to_surface_mesh(read_ply(std::string(MENISCUS_TEST_DATA_DIR) +
-                                 "/regression/curl_noise_a4_t28.1.ply"),
-                        "curl_noise_a4_t28.1.ply");
-    ASSERT_EQ(mesh.count_live_triangles(), 44794);
-    ASSERT_TRUE(find_self_intersections(mesh).triangle_pairs.empty());
-    // validate's A4 field (app/validate.cpp) at the run's time and step.
-    CurlNoiseOptions noise;
-    noise.planar = true;
-    noise.rms_speed = 0.05;
-    noise.base_wavelength = 0.5;
-    noise.time_frequency = 1.0;
-    const CurlNoiseField field(noise);
-    const FlowStep step = VelocityFieldStepper(field).step(mesh, 28.100000000000264, 0.05);
-    const std::vector<Vec3> x0 = mesh.positions();
-    for (double xi : {0.040977574596089125, edge_length_stats(mesh).mean}) {
+    const CurlNoiseState s =
+        curl_noise_state("curl_noise_a4_t28.1.ply", 44794, 28.100000000000264);
+    for (double xi : {CURL_NOISE_XI, edge_length_stats(s.mesh).mean}) {
         SCOPED_TRACE("xi " + std::to_string(xi));
-        std::vector<Vec3> x1 = x0;
-        for (size_t i = 0; i < x1.size(); ++i)
-            x1[i] += step.displacements[i];
-        CollisionOptions options;
-        options.proximity_epsilon = TrackerOptions{}.proximity_fraction * xi;
-        const CollisionReport r = resolve_collisions(mesh, x0, x1, step.dt, options);
+        const CollisionReport r = resolve_curl_noise_step(s, xi);
         EXPECT_GT(r.collisions_first_sweep, 500);  // the hard case is still exercised
         EXPECT_GT(r.impact_zone_iterations, 0);
         EXPECT_LE(r.impact_zone_iterations, 12);
@@ -309,9 +335,6 @@ TEST(CollisionRegression, CurlNoiseSheetsAtT28ResolveInAFewImpactZoneRounds) {
         EXPECT_EQ(r.step_shortenings, 0);
         EXPECT_EQ(r.motion_fraction, 1.0);
         EXPECT_TRUE(r.collision_free);
-        SurfaceMesh moved = mesh;
-        moved.set_positions(x1);
-        EXPECT_TRUE(find_self_intersections(moved).triangle_pairs.empty());
     }
 }
 
@@ -319,29 +342,12 @@ TEST(CollisionRegression, CurlNoiseSheetsAtT28ResolveInAFewImpactZoneRounds) {
 // zones solved as an active set of equalities cycled — rows with λ < 0 left the set, the
 // correction left them violated, they joined again — and six contacts stayed violated by
 // 1.6e-4 m through all 64 detect/solve rounds; the rigid fallback failed as well and the
-// step was halved twice (17 s instead of 2.5 s). Projected Gauss–Seidel on the dual ends it
-// in a few rounds at full length.
+// step was halved twice (17 s instead of 2.5 s). Projected Gauss–Seidel on the dual, when
+// the active set does not settle, ends it in a few rounds at full length.
 TEST(CollisionRegression, CurlNoiseSheetsAtT27ImpactZonesConvergeWithoutShortening) {
-    const SurfaceMesh mesh =
-        to_surface_mesh(read_ply(std::string(MENISCUS_TEST_DATA_DIR) +
-                                 "/regression/curl_noise_a4_t27.2.ply"),
-                        "curl_noise_a4_t27.2.ply");
-    ASSERT_EQ(mesh.count_live_triangles(), 54914);
-    ASSERT_TRUE(find_self_intersections(mesh).triangle_pairs.empty());
-    CurlNoiseOptions noise;  // validate's A4 field, as above
-    noise.planar = true;
-    noise.rms_speed = 0.05;
-    noise.base_wavelength = 0.5;
-    noise.time_frequency = 1.0;
-    const CurlNoiseField field(noise);
-    const FlowStep step = VelocityFieldStepper(field).step(mesh, 27.200000000000003, 0.05);
-    const std::vector<Vec3> x0 = mesh.positions();
-    std::vector<Vec3> x1 = x0;
-    for (size_t i = 0; i < x1.size(); ++i)
-        x1[i] += step.displacements[i];
-    CollisionOptions options;
-    options.proximity_epsilon = TrackerOptions{}.proximity_fraction * 0.040977574596089125;
-    const CollisionReport r = resolve_collisions(mesh, x0, x1, step.dt, options);
+    const CurlNoiseState s =
+        curl_noise_state("curl_noise_a4_t27.2.ply", 54914, 27.200000000000003);
+    const CollisionReport r = resolve_curl_noise_step(s, CURL_NOISE_XI);
     EXPECT_GT(r.collisions_first_sweep, 2000);  // the hard case is still exercised
     EXPECT_GT(r.impact_zone_iterations, 0);
     EXPECT_LE(r.impact_zone_iterations, 32);
@@ -349,9 +355,6 @@ TEST(CollisionRegression, CurlNoiseSheetsAtT27ImpactZonesConvergeWithoutShorteni
     EXPECT_EQ(r.step_shortenings, 0);
     EXPECT_EQ(r.motion_fraction, 1.0);
     EXPECT_TRUE(r.collision_free);
-    SurfaceMesh moved = mesh;
-    moved.set_positions(x1);
-    EXPECT_TRUE(find_self_intersections(moved).triangle_pairs.empty());
 }
 
 }  // namespace
