@@ -193,6 +193,10 @@ struct FrameWork {
     long long step_shortenings = 0;
     long long flow_shortenings = 0;  ///< steps the flow's own limit shortened (inversion, CFL)
     int intersecting_pairs = -1;  ///< worst exact check result of the frame, −1 = not checked
+    /// Change of the enclosed volume over the frame's steps (m³): by mesh improvement and
+    /// topology changes, by the flow's motion as requested (shortened by the fraction collision
+    /// handling applied), and by what collision handling changed of that motion.
+    double volume_remeshing = 0.0, volume_motion = 0.0, volume_collisions = 0.0;
 };
 
 class FrameWriter {
@@ -260,6 +264,10 @@ nlohmann::json frame_stats(int frame, double time, double dt, long long steps,
             {"step_shortenings", work.step_shortenings},
             {"flow_step_shortenings", work.flow_shortenings},
             {"intersecting_pairs", work.intersecting_pairs},
+            {"volume_change_by_phase",
+             {{"remeshing", work.volume_remeshing},
+              {"motion", work.volume_motion},
+              {"collisions", work.volume_collisions}}},
             {"seconds",
              {{"improvement", work.improvement},
               {"topology", work.topology},
@@ -557,12 +565,15 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
                 if (b > t && b < next_stop)
                     next_stop = b;
             const double offered = std::min(scene.time.dt, next_stop - t);
+            const double volume_before = tracker::enclosed_volume(mesh);
             auto start = Clock::now();
             tracker.improve();
             work.improvement += seconds_since(start);
             start = Clock::now();
             tracker.change_topology();  // compacts: vertex indices may change
             work.topology += seconds_since(start);
+            const double volume_remeshed = tracker::enclosed_volume(mesh);
+            work.volume_remeshing += volume_remeshed - volume_before;
             velocities.assign(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
             start = Clock::now();
             dt = offered;
@@ -574,9 +585,15 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
                     velocities[vi] = step.displacements[vi] / dt;
             }
             work.set_velocity += seconds_since(start);
+            std::vector<Vec3> requested = mesh.positions();
             start = Clock::now();
             const tracker::IntegrateResult r = tracker.integrate(velocities, dt);
             work.collisions += seconds_since(start);
+            for (size_t vi = 0; vi < requested.size(); ++vi)
+                requested[vi] += r.time_advanced * velocities[vi];
+            const double volume_requested = tracker::enclosed_volume(mesh, requested);
+            work.volume_motion += volume_requested - volume_remeshed;
+            work.volume_collisions += tracker::enclosed_volume(mesh) - volume_requested;
             work.collisions_found += r.collisions.collisions_first_sweep;
             work.impact_zone_iterations += r.collisions.impact_zone_iterations;
             work.step_shortenings += r.collisions.step_shortenings;

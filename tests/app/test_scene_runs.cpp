@@ -210,7 +210,7 @@ TEST(FlowScenes, ThinSheetSizingGainsLessVolumeUnderCurlNoise) {
     // sheets thinner than their chord sag meet and collision handling holds them apart, which
     // adds volume; thin-sheet sizing refines there. Measured: +0.34 % on 7868 triangles
     // uniform, +0.09 % on 11000 sized.
-    const auto volume_change = [](const char* name, int& triangles) {
+    const auto volume_change = [](const char* name, int& triangles, double& by_collisions) {
         Scene scene = load_scene(FLOW_SCENES + name);
         scene.output.ply = false;
         RunOptions options;
@@ -223,16 +223,36 @@ TEST(FlowScenes, ThinSheetSizingGainsLessVolumeUnderCurlNoise) {
         const std::vector<nlohmann::json> stats = read_stats(options.out_dir);
         fs::remove_all(options.out_dir);
         triangles = stats.back()["triangles"].get<int>();
-        return stats.back()["volume"].get<double>() / stats.front()["volume"].get<double>() - 1.0;
+        const double v0 = stats.front()["volume"].get<double>();
+        // The frames' changes by phase add up to the whole change.
+        double by_phase = 0.0;
+        by_collisions = 0.0;
+        for (size_t i = 1; i < stats.size(); ++i) {
+            const nlohmann::json& b = stats[i]["volume_change_by_phase"];
+            by_phase += b["remeshing"].get<double>() + b["motion"].get<double>() +
+                        b["collisions"].get<double>();
+            by_collisions += b["collisions"].get<double>();
+        }
+        EXPECT_NEAR(by_phase, stats.back()["volume"].get<double>() - v0, 1e-12 * v0) << name;
+        by_collisions /= v0;
+        return stats.back()["volume"].get<double>() / v0 - 1.0;
     };
     int uniform_triangles = 0, sized_triangles = 0;
-    const double uniform = volume_change("a4_curl_noise_xi0.04.json", uniform_triangles);
-    const double sized = volume_change("a4_curl_noise_thin_sheet_xi0.04.json", sized_triangles);
+    double uniform_by_collisions = 0.0, sized_by_collisions = 0.0;
+    const double uniform =
+        volume_change("a4_curl_noise_xi0.04.json", uniform_triangles, uniform_by_collisions);
+    const double sized = volume_change("a4_curl_noise_thin_sheet_xi0.04.json", sized_triangles,
+                                       sized_by_collisions);
     std::cout << "[ measured ] A4 ξ=0.04 at t=12: volume " << 100.0 * uniform << " % on "
               << uniform_triangles << " triangles uniform, " << 100.0 * sized << " % on "
-              << sized_triangles << " with thin-sheet sizing\n";
+              << sized_triangles << " with thin-sheet sizing; by collision handling "
+              << 100.0 * uniform_by_collisions << " % and " << 100.0 * sized_by_collisions
+              << " %\n";
     EXPECT_GT(uniform, 0.002);
     EXPECT_LT(std::abs(sized), 0.5 * uniform);
+    // Collision handling's share: measured +0.12 % uniform by t = 12.
+    EXPECT_GT(uniform_by_collisions, 0.0005);
+    EXPECT_LT(sized_by_collisions, uniform_by_collisions);
     EXPECT_GT(sized_triangles, uniform_triangles);
 }
 
