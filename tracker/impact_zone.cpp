@@ -137,12 +137,13 @@ public:
             miss[r] = c.target - relative_normal_displacement(c, d);
         }
         miss -= A * lambda;
+        const Eigen::VectorXd diagonal = A.diagonal();
         for (int sweep = 0; sweep < PGS_MAX_SWEEPS && miss.maxCoeff() > tolerance; ++sweep)
             for (int r = 0; r < m; ++r) {
-                const double diagonal = A.coeff(r, r);
-                if (!(diagonal > 0.0))
+                if (!(diagonal[r] > 0.0))
                     continue;  // every vertex of the row pinned
-                const double change = std::max(0.0, lambda[r] + miss[r] / diagonal) - lambda[r];
+                const double change =
+                    std::max(0.0, lambda[r] + miss[r] / diagonal[r]) - lambda[r];
                 if (change == 0.0)
                     continue;
                 lambda[r] += change;
