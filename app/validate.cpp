@@ -526,34 +526,43 @@ void case_a3(Context& c) {
 }
 
 void case_a4(Context& c) {
-    tracker::CurlNoiseOptions noise;
-    noise.planar = true;
-    noise.rms_speed = CURL_RMS_SPEED;
-    noise.base_wavelength = CURL_WAVELENGTH;
-    noise.time_frequency = CURL_TIME_FREQUENCY;
     struct Holder {
         tracker::CurlNoiseField field;
         tracker::VelocityFieldStepper stepper;
         explicit Holder(const tracker::CurlNoiseOptions& o) : field(o), stepper(field) {}
     };
-    const auto holder = std::make_shared<Holder>(noise);
+    const auto field = [](int octaves, double rms_speed) {
+        tracker::CurlNoiseOptions noise;
+        noise.planar = true;
+        noise.octaves = octaves;
+        noise.rms_speed = rms_speed;
+        noise.base_wavelength = CURL_WAVELENGTH;
+        noise.time_frequency = CURL_TIME_FREQUENCY;
+        return std::make_shared<Holder>(noise);
+    };
+    const auto paper_like = field(CURL_OCTAVES, CURL_RMS_SPEED);
     struct Curl {
         bool safety;
         double xi;
         bool thin_sheet_sizing;
+        bool three_octaves;
     };
     // Quick: only the (cheap) run without collision safety, which must show intersections.
-    std::vector<Curl> runs{{false, CURL_XI, false}};
+    std::vector<Curl> runs{{false, CURL_XI, false, false}};
+    std::shared_ptr<Holder> multiscale;
     if (c.full) {
         for (double xi : CURL_XI_FULL)
-            runs.push_back({true, xi, false});
-        runs.push_back({true, CURL_XI, true});
+            runs.push_back({true, xi, false, false});
+        runs.push_back({true, CURL_XI, true, false});
+        runs.push_back({true, CURL_XI, false, true});
+        multiscale = field(CURL_MULTISCALE_OCTAVES, CURL_MULTISCALE_RMS_SPEED);
     }
-    for (const auto& [safety, xi, thin_sheet_sizing] : runs) {
+    for (const auto& [safety, xi, thin_sheet_sizing, three_octaves] : runs) {
         RunSpec s;
         s.case_id = "A4";
-        s.label = !safety              ? "curl noise, collision safety off"
+        s.label = !safety             ? "curl noise, collision safety off"
                   : thin_sheet_sizing ? "curl noise, thin-sheet sizing"
+                  : three_octaves     ? "curl noise, three octaves"
                                       : "curl noise";
         s.xi_requested = xi;
         s.shape = tracker::make_sphere(Vec3::Zero(), CURL_RADIUS);
@@ -566,11 +575,13 @@ void case_a4(Context& c) {
             s.tracker.remesh.thin_sheet_sag_fraction = CURL_THIN_SHEET_SAG_FRACTION;
             s.tracker.remesh.min_curvature_size_fraction = CURL_THIN_SHEET_MIN_SIZE_FRACTION;
         }
+        const std::shared_ptr<Holder>& holder = three_octaves ? multiscale : paper_like;
         s.stepper = std::shared_ptr<const tracker::FlowStepper>(holder, &holder->stepper);
         s.t_end = safety ? CURL_END : CURL_UNSAFE_END;
         s.max_dt = CURL_DT;
         const RunResult r = run_tracked(s, c.quiet);
         Json j = run_json(r);
+        const tracker::CurlNoiseOptions& noise = holder->field.options();
         j["noise"] = {{"planar", noise.planar},
                       {"rms_speed", noise.rms_speed},
                       {"base_wavelength", noise.base_wavelength},
@@ -662,8 +673,8 @@ int run_validation(const ValidateOptions& options) {
        << (c.all_ok ? "all runs finished, no intersections with safety on" : "FAILURES") << "**";
     for (const std::string& f : c.failures)
         md << "\n- " << f;
-    md << "\n\nWall time: " << format_number(seconds_since(wall_start), "%.0f") << " s. " << plot_note
-       << "\n\n"
+    md << "\n\nWall time: " << format_number(seconds_since(wall_start), "%.0f") << " s. "
+       << plot_note << "\n\n"
        << body.str();
     std::ofstream f(out / "report.md");
     if (!f)

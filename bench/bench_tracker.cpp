@@ -131,15 +131,16 @@ void BM_IntegrateCrushed(benchmark::State& state) {
         benchmark::Counter(collisions, benchmark::Counter::kAvgIterations);
 }
 
-/// Contact-heavy, from a real run: one collision resolution of A4 curl noise (ξ = 0.04, validate's
-/// field) on thin sheets pressed together, from the states kept for the collision regression
+/// Contact-heavy, from a real run: one collision resolution of A4 curl noise (ξ = 0.04, the
+/// three-octave field) on thin sheets pressed together, from the states kept for the collision regression
 /// tests (tests/data/regression): t = 27.2 (54 914 triangles, where an active-set impact-zone
 /// solve cycled and halved the step twice) and t = 28.1 (44 794 triangles).
 void BM_ResolveCurlNoiseSheets(benchmark::State& state, const char* file, double t) {
     const SurfaceMesh mesh = to_surface_mesh(
         read_ply(std::string(MENISCUS_TEST_DATA_DIR) + "/regression/" + file), file);
-    CurlNoiseOptions noise;
+    CurlNoiseOptions noise;  // the three-octave field the states were recorded in
     noise.planar = true;
+    noise.octaves = 3;
     noise.rms_speed = 0.05;
     noise.base_wavelength = 0.5;
     noise.time_frequency = 1.0;

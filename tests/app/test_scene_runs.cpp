@@ -12,8 +12,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -146,7 +146,7 @@ TEST(FlowScenes, SphereUnderMeanCurvatureRecordsTheExactRadius) {
     options.out_dir = (fs::temp_directory_path() / "meniscus_a2_exact").string();
     const fs::path last_frame = fs::path(options.out_dir) / "surface_0002.ply";
     ASSERT_FALSE(scene.time.land_on_frames);  // steps as in `meniscus validate`
-    options.frames = 2;                        // frame times 0.00125 and 0.0025
+    options.frames = 2;                       // frame times 0.00125 and 0.0025
     options.quiet = true;
     const std::atomic<bool> stop{false};
     run_scene(scene, options, stop);
@@ -163,8 +163,8 @@ TEST(FlowScenes, SphereUnderMeanCurvatureRecordsTheExactRadius) {
     EXPECT_DOUBLE_EQ(lines[1]["exact_error"]["radius"].get<double>(), exact_radius);
     // The sphere shrank by 0.017 m; the discrete flow follows it to a small fraction of that.
     EXPECT_LT(lines[1]["exact_error"]["vertex_linf"].get<double>(), 0.1 * (0.3 - exact_radius));
-    const tracker::SurfaceMesh mesh = tracker::to_surface_mesh(
-        tracker::read_mesh_file(last_frame.string()), "ply");
+    const tracker::SurfaceMesh mesh =
+        tracker::to_surface_mesh(tracker::read_mesh_file(last_frame.string()), "ply");
     EXPECT_NEAR(lines[1]["exact_error"]["l1"].get<double>(),
                 tracker::sphere_error(mesh, Eigen::Vector3d::Zero(), exact_radius).l1, 1e-12);
     fs::remove_all(options.out_dir);
@@ -205,11 +205,45 @@ TEST(FlowScenes, OpenSheetKeepsItsBoundaryUnderCurlNoise) {
     fs::remove_all(options.out_dir);
 }
 
+TEST(FlowScenes, CurlNoiseStretchesTheSphereAndKeepsItsVolume) {
+    // A4's paper-like field at ξ = 0.04 to t = 15, collision safety on: the field is
+    // divergence-free, so the enclosed volume may change only by discretization. Measured:
+    // 1090 → 9736 triangles (8.9×), volume +0.13 %, of which collision handling +0.014 %.
+    Scene scene = load_scene(FLOW_SCENES + "a4_curl_noise_xi0.04.json");
+    scene.output.ply = false;
+    RunOptions options;
+    options.out_dir = (fs::temp_directory_path() / "meniscus_curl_noise").string();
+    options.frames = 15;
+    options.quiet = true;
+    const std::atomic<bool> stop{false};
+    const RunResult r = run_scene(scene, options, stop);
+    EXPECT_EQ(r.max_intersecting_pairs, 0);
+    const std::vector<nlohmann::json> stats = read_stats(options.out_dir);
+    fs::remove_all(options.out_dir);
+    ASSERT_EQ(stats.size(), 16u);
+    EXPECT_DOUBLE_EQ(stats.back()["time"].get<double>(), 15.0);
+    const double v0 = stats.front()["volume"].get<double>();
+    double by_collisions = 0.0;
+    for (size_t i = 1; i < stats.size(); ++i) {
+        EXPECT_EQ(stats[i]["intersecting_pairs"].get<int>(), 0) << "frame " << i;
+        by_collisions += stats[i]["volume_change_by_phase"]["collisions"].get<double>();
+    }
+    const double change = stats.back()["volume"].get<double>() / v0 - 1.0;
+    const int triangles = stats.back()["triangles"].get<int>();
+    std::cout << "[ measured ] A4 ξ=0.04 at t=15: " << triangles << " triangles, volume "
+              << 100.0 * change << " %, by collision handling " << 100.0 * by_collisions / v0
+              << " %\n";
+    EXPECT_GT(triangles, 8 * stats.front()["triangles"].get<int>());
+    EXPECT_LT(std::abs(change), 0.003);
+    EXPECT_LT(std::abs(by_collisions / v0), 0.0005);
+}
+
 TEST(FlowScenes, ThinSheetSizingGainsLessVolumeUnderCurlNoise) {
-    // A4 to t = 12, when the sphere has been drawn into folded sheets: the discretized sides of
-    // sheets thinner than their chord sag meet and collision handling holds them apart, which
-    // adds volume; thin-sheet sizing refines there. Measured: +0.34 % on 7868 triangles
-    // uniform, +0.09 % on 11000 sized.
+    // A4's three-octave field to t = 12, when the sphere has been drawn into folded sheets: the
+    // discretized sides of sheets thinner than their chord sag meet and collision handling holds
+    // them apart, which adds volume; thin-sheet sizing refines there. Measured: +0.34 % on 7868
+    // triangles uniform, +0.09 % on 11000 sized. (The paper-like one-octave field folds later:
+    // collision handling has added under 0.001 % by t = 12, too little to compare.)
     const auto volume_change = [](const char* name, int& triangles, double& by_collisions) {
         Scene scene = load_scene(FLOW_SCENES + name);
         scene.output.ply = false;
@@ -239,13 +273,13 @@ TEST(FlowScenes, ThinSheetSizingGainsLessVolumeUnderCurlNoise) {
     };
     int uniform_triangles = 0, sized_triangles = 0;
     double uniform_by_collisions = 0.0, sized_by_collisions = 0.0;
-    const double uniform =
-        volume_change("a4_curl_noise_xi0.04.json", uniform_triangles, uniform_by_collisions);
-    const double sized = volume_change("a4_curl_noise_thin_sheet_xi0.04.json", sized_triangles,
-                                       sized_by_collisions);
-    std::cout << "[ measured ] A4 ξ=0.04 at t=12: volume " << 100.0 * uniform << " % on "
-              << uniform_triangles << " triangles uniform, " << 100.0 * sized << " % on "
-              << sized_triangles << " with thin-sheet sizing; by collision handling "
+    const double uniform = volume_change("a4_curl_noise_multiscale_xi0.04.json", uniform_triangles,
+                                         uniform_by_collisions);
+    const double sized = volume_change("a4_curl_noise_multiscale_thin_sheet_xi0.04.json",
+                                       sized_triangles, sized_by_collisions);
+    std::cout << "[ measured ] A4 three octaves ξ=0.04 at t=12: volume " << 100.0 * uniform
+              << " % on " << uniform_triangles << " triangles uniform, " << 100.0 * sized
+              << " % on " << sized_triangles << " with thin-sheet sizing; by collision handling "
               << 100.0 * uniform_by_collisions << " % and " << 100.0 * sized_by_collisions
               << " %\n";
     EXPECT_GT(uniform, 0.002);

@@ -203,7 +203,7 @@ TEST_F(QuickValidation, ReportHasEveryCaseTable) {
                               "| ξ | triangles | improvement", "| ξ | R₀ | t | steps | exact R(t)",
                               "| ξ | period | steps | triangles | volume change %",
                               "| ξ | t | steps | max intersecting pairs | steps with intersections",
-                              "| run | ξ | t | steps | triangles | volume change %"})
+                              "| run | octaves, RMS m/s | ξ | t | steps | triangles | volume change %"})
         EXPECT_NE(s_report.find(table), std::string::npos) << table;
     EXPECT_NE(s_report.find("0.00811073"), std::string::npos);  // the paper's numbers beside ours
 }
