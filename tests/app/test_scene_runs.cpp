@@ -108,6 +108,23 @@ std::vector<nlohmann::json> read_stats(const fs::path& dir) {
 
 const std::string FLOW_SCENES = std::string(MENISCUS_SOURCE_DIR) + "/scenes/flows/";
 
+/// The stats.jsonl lines of a shipped flow scene run for `frames` frames without PLY output;
+/// the run itself must stay intersection-free.
+std::vector<nlohmann::json> flow_scene_stats(const std::string& name, int frames) {
+    Scene scene = load_scene(FLOW_SCENES + name);
+    scene.output.ply = false;
+    RunOptions options;
+    options.out_dir = (fs::temp_directory_path() / ("meniscus_" + name)).string();
+    options.frames = frames;
+    options.quiet = true;
+    const std::atomic<bool> stop{false};
+    const RunResult r = run_scene(scene, options, stop);
+    EXPECT_EQ(r.max_intersecting_pairs, 0) << name;
+    std::vector<nlohmann::json> stats = read_stats(options.out_dir);
+    fs::remove_all(options.out_dir);
+    return stats;
+}
+
 TEST(FlowScenes, A1ErrorInStatsIsTheFlowErrorsComputation) {
     Scene scene = load_scene(FLOW_SCENES + "a1_face_offsetting_xi0.04.json");
     RunOptions options;
@@ -209,17 +226,7 @@ TEST(FlowScenes, CurlNoiseStretchesTheSphereAndKeepsItsVolume) {
     // A4's paper-like field at ξ = 0.04 to t = 15, collision safety on: the field is
     // divergence-free, so the enclosed volume may change only by discretization. Measured:
     // 1090 → 9736 triangles (8.9×), volume +0.13 %, of which collision handling +0.014 %.
-    Scene scene = load_scene(FLOW_SCENES + "a4_curl_noise_xi0.04.json");
-    scene.output.ply = false;
-    RunOptions options;
-    options.out_dir = (fs::temp_directory_path() / "meniscus_curl_noise").string();
-    options.frames = 15;
-    options.quiet = true;
-    const std::atomic<bool> stop{false};
-    const RunResult r = run_scene(scene, options, stop);
-    EXPECT_EQ(r.max_intersecting_pairs, 0);
-    const std::vector<nlohmann::json> stats = read_stats(options.out_dir);
-    fs::remove_all(options.out_dir);
+    const std::vector<nlohmann::json> stats = flow_scene_stats("a4_curl_noise_xi0.04.json", 15);
     ASSERT_EQ(stats.size(), 16u);
     EXPECT_DOUBLE_EQ(stats.back()["time"].get<double>(), 15.0);
     const double v0 = stats.front()["volume"].get<double>();
@@ -245,17 +252,7 @@ TEST(FlowScenes, ThinSheetSizingGainsLessVolumeUnderCurlNoise) {
     // triangles uniform, +0.09 % on 11000 sized. (The paper-like one-octave field folds later:
     // collision handling has added under 0.001 % by t = 12, too little to compare.)
     const auto volume_change = [](const char* name, int& triangles, double& by_collisions) {
-        Scene scene = load_scene(FLOW_SCENES + name);
-        scene.output.ply = false;
-        RunOptions options;
-        options.out_dir = (fs::temp_directory_path() / "meniscus_thin_sheet").string();
-        options.frames = 12;
-        options.quiet = true;
-        const std::atomic<bool> stop{false};
-        const RunResult r = run_scene(scene, options, stop);
-        EXPECT_EQ(r.max_intersecting_pairs, 0) << name;
-        const std::vector<nlohmann::json> stats = read_stats(options.out_dir);
-        fs::remove_all(options.out_dir);
+        const std::vector<nlohmann::json> stats = flow_scene_stats(name, 12);
         triangles = stats.back()["triangles"].get<int>();
         const double v0 = stats.front()["volume"].get<double>();
         // The frames' changes by phase add up to the whole change.
