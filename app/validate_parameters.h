@@ -78,7 +78,7 @@ inline constexpr double ENRIGHT_QUICK_PERIOD = 1.0;
 /// 43×). Ours: one octave of random Fourier modes (base wavelength 0.5 m, twice the sphere's
 /// radius), unsteady so that sheets fold, with the RMS speed the round value at which our uniform
 /// runs grow at least as much as the paper's by t = 30: 48× at ξ = 0.04 (0.065 m/s gives 36×),
-/// 70× at ξ = 0.02 (finer meshes resolve more folds).
+/// 70× at ξ = 0.02 and 80× at ξ = 0.0141 (finer meshes resolve more folds).
 inline constexpr double CURL_RADIUS = 0.25;
 inline constexpr int CURL_OCTAVES = 1;
 inline constexpr double CURL_RMS_SPEED = 0.07;  ///< m/s
@@ -115,8 +115,8 @@ inline constexpr int PAPER_CURL_INITIAL_TRIANGLES = 8798;
 inline constexpr int MAX_STALLED_STEPS = 50;
 inline constexpr double STALL_FRACTION = 1e-6;
 /// A run stops when the mesh exceeds this many triangles (a field stretching the surface
-/// without bound would otherwise exhaust time and memory). A4 at ξ = 0.02 ends at 308 752 (the
-/// paper's own run at its finer resolution: 381 092).
+/// without bound would otherwise exhaust time and memory). A4 at ξ = 0.0141 ends at 708 076
+/// (the paper's own run: 381 092).
 inline constexpr int MAX_TRIANGLES = 1000000;
 /// Off a terminal, a run's progress line is written at most this often (s of wall time).
 inline constexpr double PROGRESS_LINE_SECONDS = 30.0;

@@ -321,10 +321,10 @@ void report_a4(std::ostringstream& md, const Json& results) {
        << fmt(CURL_WAVELENGTH) << " m, mode frequencies up to " << fmt(CURL_TIME_FREQUENCY)
        << " rad/s and RMS speed " << fmt(CURL_RMS_SPEED) << " m/s (our parameters: the paper "
        << "gives neither its potential nor its speed; at this speed our meshes grow at least as "
-       << "much as the paper's, 43× by t = 30: 48× at ξ = 0.04, 70× at ξ = 0.02). Sphere r = "
-       << fmt(CURL_RADIUS) << ", RK4 Δt = " << fmt(CURL_DT)
+       << "much as the paper's, 43× by t = 30: 48× at ξ = 0.04, 70× at ξ = 0.02, 80× at "
+       << "ξ = 0.0141). Sphere r = " << fmt(CURL_RADIUS) << ", RK4 Δt = " << fmt(CURL_DT)
        << ", topology changes off, γ = 5e-4 ξ³. The paper's run starts from "
-       << PAPER_CURL_INITIAL_TRIANGLES << " triangles (ξ ≈ 0.014 on this sphere). The volume "
+       << PAPER_CURL_INITIAL_TRIANGLES << " triangles (ours 8812 at ξ = 0.0141). The volume "
        << "grows where a sheet becomes thinner than the chord sag of its discretized sides: they "
        << "meet and collision handling holds them apart. The thin-sheet sizing run (ours, not "
        << "the paper's) shrinks edges there, to " << fmt(CURL_THIN_SHEET_MIN_SIZE_FRACTION)
