@@ -4,6 +4,7 @@
 #include "app/validate_report.h"
 
 #include "app/validate_parameters.h"
+#include "tracker/flows/curl_noise.h"
 
 #include <cmath>
 #include <cstdio>
@@ -330,7 +331,9 @@ void report_a4(std::ostringstream& md, const Json& results) {
        << "the paper's) shrinks edges there, to " << fmt(CURL_THIN_SHEET_MIN_SIZE_FRACTION)
        << " α at most, until the sag is below " << fmt(CURL_THIN_SHEET_SAG_FRACTION)
        << " times the sheet's thickness. The three-octave run is a harder field ("
-       << CURL_MULTISCALE_OCTAVES << " octaves down to wavelength " << fmt(CURL_WAVELENGTH / 4.0)
+       << CURL_MULTISCALE_OCTAVES << " octaves down to wavelength "
+       << fmt(CURL_WAVELENGTH /
+              std::pow(tracker::CurlNoiseOptions{}.lacunarity, CURL_MULTISCALE_OCTAVES - 1))
        << " m, about 3ξ at ξ = 0.04, RMS " << fmt(CURL_MULTISCALE_RMS_SPEED)
        << " m/s) that folds the surface below what the mesh resolves. The volume change splits "
           "into what mesh improvement, the flow's motion and collision handling changed; the "
