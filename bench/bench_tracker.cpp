@@ -1,6 +1,7 @@
 // Broad phase, static intersection check and a whole collision-safe integrate() step at
 // 10k, 50k and 200k triangles (issue 3), and collision resolution on A4 curl-noise states. Meshes: spheres meshed at an edge length chosen for
 // the triangle count; motion: a smooth swirl plus a random jitter of 5 % of an edge per step.
+#include "tests/tracker/curl_noise_a4_states.h"
 #include "tracker/broadphase.h"
 #include "tracker/collision_resolution.h"
 #include "tracker/flows/curl_noise.h"
@@ -138,14 +139,9 @@ void BM_IntegrateCrushed(benchmark::State& state) {
 void BM_ResolveCurlNoiseSheets(benchmark::State& state, const char* file, double t) {
     const SurfaceMesh mesh = to_surface_mesh(
         read_ply(std::string(MENISCUS_TEST_DATA_DIR) + "/regression/" + file), file);
-    CurlNoiseOptions noise;  // the three-octave field the states were recorded in
-    noise.planar = true;
-    noise.octaves = 3;
-    noise.rms_speed = 0.05;
-    noise.base_wavelength = 0.5;
-    noise.time_frequency = 1.0;
-    const CurlNoiseField field(noise);
-    const FlowStep step = VelocityFieldStepper(field).step(mesh, t, 0.05);
+    namespace recorded = meniscus::tracker::testing;
+    const CurlNoiseField field(recorded::recorded_a4_field());
+    const FlowStep step = VelocityFieldStepper(field).step(mesh, t, recorded::RECORDED_A4_DT);
     std::vector<Vec3> requested = mesh.positions();
     for (size_t i = 0; i < requested.size(); ++i)
         requested[i] += step.displacements[i];

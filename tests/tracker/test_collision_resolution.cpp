@@ -1,4 +1,5 @@
 #include "tracker/collision_resolution.h"
+#include "tests/tracker/curl_noise_a4_states.h"
 #include "tracker/flows/curl_noise.h"
 #include "tracker/flows/flow_runner.h"
 #include "tracker/implicit_mesher.h"
@@ -282,15 +283,8 @@ CurlNoiseState curl_noise_state(const std::string& file, int triangles, double t
                              file);
     EXPECT_EQ(s.mesh.count_live_triangles(), triangles);
     EXPECT_TRUE(find_self_intersections(s.mesh).triangle_pairs.empty());
-    // The three-octave A4 field the states were recorded in (a4_curl_noise_multiscale_xi0.04).
-    CurlNoiseOptions noise;
-    noise.planar = true;
-    noise.octaves = 3;
-    noise.rms_speed = 0.05;
-    noise.base_wavelength = 0.5;
-    noise.time_frequency = 1.0;
-    const CurlNoiseField field(noise);
-    const FlowStep step = VelocityFieldStepper(field).step(s.mesh, t, 0.05);
+    const CurlNoiseField field(testing::recorded_a4_field());
+    const FlowStep step = VelocityFieldStepper(field).step(s.mesh, t, testing::RECORDED_A4_DT);
     s.x0 = s.mesh.positions();
     s.x1 = s.x0;
     for (size_t i = 0; i < s.x1.size(); ++i)
