@@ -20,6 +20,20 @@ namespace {
 
 using namespace testing;
 
+/// Half the distance between the overlapping balls' centres in the neck tests (m).
+constexpr double NECK_HALF_SEPARATION = 0.1;
+
+/// The neck tests' two overlapping balls of radius 0.3, centres ±NECK_HALF_SEPARATION on x,
+/// moving outward until `reversal_time` and inward after it.
+TwoSphereNormalFlow overlapping_balls_flow(double reversal_time) {
+    TwoSphereNormalFlow flow;
+    flow.center0 = Vec3(-NECK_HALF_SEPARATION, 0, 0);
+    flow.center1 = Vec3(NECK_HALF_SEPARATION, 0, 0);
+    flow.initial_radius = 0.3;
+    flow.reversal_time = reversal_time;
+    return flow;
+}
+
 TEST(FlowRunner, FaceOffsettingSphereFollowsExactRadiusBothWays) {
     const Vec3 center(0.25, 0.0, 0.0);
     const double r0 = 0.2, speed = 0.2, t_end = 0.5;
@@ -85,12 +99,8 @@ TEST(FlowRunner, NeckFaceOffsettingConvergesWhereVertexNormalsDoNot) {
     // Exact solution: the union of the two balls of radius r + s t (TwoSphereNormalFlow with
     // centres ±a). Face offsetting tracks it; vertex normals lag at the ring by
     // s t (1/cos θ − 1) whatever the resolution (paper Fig. 4.2).
-    TwoSphereNormalFlow flow;
-    const double a = 0.1;
-    flow.center0 = Vec3(-a, 0, 0);
-    flow.center1 = Vec3(a, 0, 0);
-    flow.initial_radius = 0.3;
-    flow.reversal_time = 1.0;
+    const TwoSphereNormalFlow flow = overlapping_balls_flow(1.0);
+    const double a = NECK_HALF_SEPARATION;
     const double t_end = 0.1;  // s t = 0.02
     std::vector<double> fo_errors, vn_errors, xis;
     for (double xi : {0.04, 0.02, 0.01}) {
@@ -123,12 +133,8 @@ TEST(FlowRunner, ShrinkingNeckNeedsTheHuygensRuleToConverge) {
     // solution is the erosion {dist(x, complement of U) > s t} with a rounded neck
     // (TwoSphereNormalFlow with the reversal at t = 0). The plane-intersection rule keeps the
     // crease sharp and overshoots by s t (1/cos θ − 1) at every resolution.
-    TwoSphereNormalFlow flow;
-    const double a = 0.1;
-    flow.center0 = Vec3(-a, 0, 0);
-    flow.center1 = Vec3(a, 0, 0);
-    flow.initial_radius = 0.3;
-    flow.reversal_time = 0.0;
+    const TwoSphereNormalFlow flow = overlapping_balls_flow(0.0);
+    const double a = NECK_HALF_SEPARATION;
     const double t_end = 0.1;  // s t = 0.02
     FaceOffsettingOptions planes;
     planes.expansion = ExpansionRule::planes;
