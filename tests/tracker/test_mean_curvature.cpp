@@ -140,6 +140,50 @@ TEST(MeanCurvature, SphereFlowFollowsExactRadius) {
     EXPECT_LT(errors[1], errors[0]);
 }
 
+/// The semi-discrete flow of one fixed mesh (no remeshing), integrated over [0, T] with steps
+/// dt and dt/2, against the same flow with steps dt/16 as the converged answer: forward Euler's
+/// error halves with the step (first order), Heun's falls by four (second order), and Heun at
+/// the coarse step is already closer than forward Euler at the fine one.
+TEST(MeanCurvature, HeunIsSecondOrderInTimeAndForwardEulerFirst) {
+    const Vec3 center(0.0, 0.0, 0.0);
+    SurfaceMesh start = meshed_sphere(center, 0.3, 0.06);
+    project_to_sphere(start, center, 0.3);
+    const double t_end = 0.005;  // R² falls from 0.09 to 0.07
+    const auto integrate = [&](MeanCurvatureIntegrator integrator, int steps) {
+        SurfaceMesh mesh = start;
+        const double dt = t_end / steps;
+        for (int i = 0; i < steps; ++i)
+            displace(mesh, mean_curvature_displacements(mesh, dt, integrator));
+        return mesh;
+    };
+    const auto max_distance = [](const SurfaceMesh& a, const SurfaceMesh& b) {
+        double d = 0.0;
+        for (int vi = 0; vi < a.num_vertices(); ++vi)
+            d = std::max(d, (a.position(vi) - b.position(vi)).norm());
+        return d;
+    };
+    const int coarse = 40;  // dt = 1.25e-4, within the CFL step 0.1 ℓ² of this mesh
+    ASSERT_LT(t_end / coarse, mean_curvature_time_step(start));
+    const SurfaceMesh converged = integrate(MeanCurvatureIntegrator::heun, 16 * coarse);
+    double euler[2], heun[2];
+    for (int k = 0; k < 2; ++k) {
+        euler[k] = max_distance(integrate(MeanCurvatureIntegrator::forward_euler, coarse << k),
+                                converged);
+        heun[k] = max_distance(integrate(MeanCurvatureIntegrator::heun, coarse << k), converged);
+    }
+    std::cout << "[ measured ] forward Euler " << euler[0] << " → " << euler[1] << ", Heun "
+              << heun[0] << " → " << heun[1] << "\n";
+    EXPECT_NEAR(euler[0] / euler[1], 2.0, 0.3);
+    EXPECT_NEAR(heun[0] / heun[1], 4.0, 0.8);
+    EXPECT_LT(heun[0], euler[1]);
+    // The forward-Euler overload is the two-argument one.
+    const std::vector<Vec3> a = mean_curvature_displacements(start, 1e-4);
+    const std::vector<Vec3> b =
+        mean_curvature_displacements(start, 1e-4, MeanCurvatureIntegrator::forward_euler);
+    for (size_t i = 0; i < a.size(); ++i)
+        EXPECT_EQ(a[i], b[i]);
+}
+
 TEST(MeanCurvature, TimeStepValidatesAndScalesWithShortestEdge) {
     const SurfaceMesh mesh = cube_mesh(1.0, 4);  // all edges ≥ 0.5
     MeanCurvatureFlowOptions options;

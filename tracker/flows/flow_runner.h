@@ -63,7 +63,8 @@ private:
     InversionLimitOptions m_inversion;
 };
 
-/// Motion by mean curvature (§4.2): forward Euler with dt = min(dt_max, CFL limit).
+/// Motion by mean curvature (§4.2): forward Euler (or Heun, MeanCurvatureFlowOptions) with
+/// dt = min(dt_max, CFL limit).
 class MeanCurvatureStepper final : public FlowStepper {
 public:
     explicit MeanCurvatureStepper(const MeanCurvatureFlowOptions& options = {});

@@ -118,4 +118,19 @@ std::vector<Vec3> mean_curvature_displacements(const SurfaceMesh& mesh, double d
     return d;
 }
 
+std::vector<Vec3> mean_curvature_displacements(const SurfaceMesh& mesh, double dt,
+                                               MeanCurvatureIntegrator integrator) {
+    std::vector<Vec3> d = mean_curvature_displacements(mesh, dt);
+    if (integrator == MeanCurvatureIntegrator::forward_euler)
+        return d;
+    SurfaceMesh predicted = mesh;
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        if (mesh.vertex_alive(vi))
+            predicted.set_position(vi, mesh.position(vi) + d[static_cast<size_t>(vi)]);
+    const std::vector<Vec3> k = mean_curvature_normals(predicted);
+    for (size_t i = 0; i < d.size(); ++i)
+        d[i] = 0.5 * (d[i] - dt * k[i]);
+    return d;
+}
+
 }  // namespace meniscus::tracker
