@@ -127,6 +127,19 @@ TEST(SurfaceErrorMeasure, L1IsTheAreaWeightedMeanDistance) {
     EXPECT_NEAR(e.vertex_l1, (0.5 / 3.0) * (0 + 1 + 1) + (0.5 / 3.0) * (0 + 1 + 0), 1e-15);
     EXPECT_NEAR(relative_volume_change(2.0, 2.1), 0.05, 1e-15);
     EXPECT_THROW(relative_volume_change(0.0, 1.0), std::invalid_argument);
+    // Signed vertex measures (the paper's): φ = 0, 1, 1, 1 at the corners (vertex 1 and 3 are
+    // shared: 1 at (1,0,1), 0 at (0,1,0)); vertex 2 at (1,1,1) is where max |φ| is first met.
+    EXPECT_NEAR(e.vertex_max_signed, 1.0, 1e-15);
+    EXPECT_NEAR(e.vertex_min_signed, 0.0, 1e-15);
+    EXPECT_NEAR(e.vertex_mean_signed, e.vertex_l1, 1e-15);
+    EXPECT_EQ(e.vertex_linf_position, Vec3(1, 0, 1));
+    // Below the plane the signed measures change sign, the norms do not.
+    auto above = [](const Vec3& x) { return x.z() - 2.0; };
+    const SurfaceError below = surface_error(tilted, above);
+    EXPECT_NEAR(below.vertex_max_signed, -1.0, 1e-15);
+    EXPECT_NEAR(below.vertex_min_signed, -2.0, 1e-15);
+    EXPECT_NEAR(below.vertex_mean_signed, -below.vertex_l1, 1e-15);
+    EXPECT_NEAR(below.vertex_linf, 2.0, 1e-15);
     SurfaceErrorOptions bad;
     bad.triangle_subdivisions = 0;
     EXPECT_THROW(surface_error(square, plane, bad), std::invalid_argument);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -23,19 +24,29 @@ SurfaceError surface_error(const SurfaceMesh& mesh,
     options.validate();
     SurfaceError error;
     std::vector<double> vertex_phi(static_cast<size_t>(mesh.num_vertices()), 0.0);
+    std::vector<double> vertex_signed(static_cast<size_t>(mesh.num_vertices()), 0.0);
+    error.vertex_max_signed = -std::numeric_limits<double>::infinity();
+    error.vertex_min_signed = std::numeric_limits<double>::infinity();
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
         if (!mesh.vertex_alive(vi))
             continue;
-        const double phi = std::abs(signed_distance(mesh.position(vi)));
+        const double signed_phi = signed_distance(mesh.position(vi));
+        const double phi = std::abs(signed_phi);
         vertex_phi[static_cast<size_t>(vi)] = phi;
-        error.vertex_linf = std::max(error.vertex_linf, phi);
+        vertex_signed[static_cast<size_t>(vi)] = signed_phi;
+        error.vertex_max_signed = std::max(error.vertex_max_signed, signed_phi);
+        error.vertex_min_signed = std::min(error.vertex_min_signed, signed_phi);
+        if (phi > error.vertex_linf) {
+            error.vertex_linf = phi;
+            error.vertex_linf_position = mesh.position(vi);
+        }
         ++error.samples;
     }
     error.linf = error.vertex_linf;
 
     const int m = options.triangle_subdivisions;
     const double inv_m = 1.0 / m;
-    double weighted_sum = 0.0, vertex_weighted_sum = 0.0;
+    double weighted_sum = 0.0, vertex_weighted_sum = 0.0, vertex_signed_sum = 0.0;
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
         if (!mesh.triangle_alive(ti))
             continue;
@@ -65,11 +76,14 @@ SurfaceError surface_error(const SurfaceMesh& mesh,
             }
         weighted_sum += area * sum / (m * m);
         error.area += area;
-        for (int vi : t)
+        for (int vi : t) {
             vertex_weighted_sum += area / 3.0 * vertex_phi[static_cast<size_t>(vi)];
+            vertex_signed_sum += area / 3.0 * vertex_signed[static_cast<size_t>(vi)];
+        }
     }
     error.l1 = error.area > 0.0 ? weighted_sum / error.area : 0.0;
     error.vertex_l1 = error.area > 0.0 ? vertex_weighted_sum / error.area : 0.0;
+    error.vertex_mean_signed = error.area > 0.0 ? vertex_signed_sum / error.area : 0.0;
     return error;
 }
 

@@ -37,6 +37,10 @@ struct SurfaceError {
     double l1 = 0.0;           ///< area-weighted mean |φ|
     double vertex_linf = 0.0;  ///< max |φ| over live vertices only
     double vertex_l1 = 0.0;    ///< mean |φ| over vertices weighted by barycentric vertex areas
+    double vertex_max_signed = 0.0;   ///< max φ over live vertices (signed; > 0 outside)
+    double vertex_min_signed = 0.0;   ///< min φ over live vertices (signed; < 0 inside)
+    double vertex_mean_signed = 0.0;  ///< Σᵥ Aᵥ φ(xᵥ) / Σᵥ Aᵥ (signed)
+    Vec3 vertex_linf_position = Vec3::Zero();  ///< where vertex_linf is attained
     double area = 0.0;         ///< total live triangle area (m²)
     long samples = 0;          ///< number of φ evaluations
 };
