@@ -268,7 +268,11 @@ Json run_json(const RunResult& r) {
 
 Json error_json(const tracker::SurfaceError& e) {
     return {
-        {"linf", e.linf}, {"l1", e.l1}, {"vertex_linf", e.vertex_linf}, {"vertex_l1", e.vertex_l1}};
+        {"linf", e.linf}, {"l1", e.l1}, {"vertex_linf", e.vertex_linf}, {"vertex_l1", e.vertex_l1},
+        {"vertex_max_signed", e.vertex_max_signed}, {"vertex_min_signed", e.vertex_min_signed},
+        {"vertex_mean_signed", e.vertex_mean_signed},
+        {"vertex_linf_position",
+         {e.vertex_linf_position.x(), e.vertex_linf_position.y(), e.vertex_linf_position.z()}}};
 }
 
 /// log(e_coarse / e_fine) / log(ξ_coarse / ξ_fine).
@@ -359,7 +363,12 @@ void case_a1(Context& c) {
 }
 
 void case_a2(Context& c) {
-    const auto stepper = std::make_shared<tracker::MeanCurvatureStepper>();
+    tracker::MeanCurvatureFlowOptions mcf;
+    if (MCF_HEUN)
+        mcf.integrator = tracker::MeanCurvatureIntegrator::heun;
+    const auto stepper = std::make_shared<tracker::MeanCurvatureStepper>(mcf);
+    tracker::TrackerOptions mcf_tracker = paper_tracker_options();
+    mcf_tracker.remesh.collapse_preserves_volume = MCF_COLLAPSE_PRESERVES_VOLUME;
     {
         const Vec3 center = Vec3::Zero();
         const double t_end = MCF_SPHERE_TIME_FRACTION * MCF_SPHERE_RADIUS * MCF_SPHERE_RADIUS / 4.0;
@@ -371,7 +380,7 @@ void case_a2(Context& c) {
             s.label = "sphere";
             s.xi_requested = xi;
             s.shape = tracker::make_sphere(center, MCF_SPHERE_RADIUS);
-            s.tracker = paper_tracker_options();
+            s.tracker = mcf_tracker;
             s.stepper = stepper;
             s.t_end = t_end;
             s.max_dt = MCF_MAX_DT;
@@ -455,7 +464,7 @@ void case_a2(Context& c) {
         s.label = "dumbbell";
         s.xi_requested = xi;
         s.shape = dumbbell;
-        s.tracker = paper_tracker_options();
+        s.tracker = mcf_tracker;
         s.stepper = stepper;
         s.t_end = DUMBBELL_END;
         s.max_dt = MCF_MAX_DT;

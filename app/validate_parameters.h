@@ -38,11 +38,30 @@ inline constexpr double MCF_SPHERE_RADIUS = 0.3;
 inline constexpr double MCF_SPHERE_TIME_FRACTION = 0.5;
 /// Upper bound offered to the CFL-limited mean-curvature stepper (s).
 inline constexpr double MCF_MAX_DT = 1e-3;
-/// A2 dumbbell (our dimensions; the paper gives only its 28×14×14 grid): bulbs, handle.
-inline constexpr double DUMBBELL_BULB_RADIUS = 0.4;
-inline constexpr double DUMBBELL_SEPARATION = 1.1;
-inline constexpr double DUMBBELL_HANDLE_RADIUS = 0.15;
-inline constexpr double DUMBBELL_BLEND_RADIUS = 0.05;
+/// A2 runs integrate with Heun's method instead of the paper's forward Euler (same CFL step,
+/// two curvature evaluations per step). Forward Euler lags by O(Δt κ²), which at the CFL step
+/// is as large as the operator's own error and is worst on the shrinking drops the dumbbell
+/// leaves at t = 0.025: vertex L∞ at ξ = 0.04 fell from 3.95e-3 to 1.59e-3 (forward Euler with a
+/// quarter of the step: 1.33e-3, at four times the steps).
+inline constexpr bool MCF_HEUN = true;
+/// A2 collapses keep the new vertex at the butterfly point, on the smooth surface, instead of
+/// lifting it to keep the volume (RemeshOptions::collapse_preserves_volume): a shrinking shape
+/// keeps collapsing edges, and each volume-keeping collapse put a vertex outside the surface,
+/// so the sphere run to 0.9 of its extinction time at ξ = 0.04 lagged by vertex L∞ 2.28e-3
+/// (3.1e-4 without) and the dumbbell by 1.48e-2 (3.95e-3 without, both forward Euler).
+inline constexpr bool MCF_COLLAPSE_PRESERVES_VOLUME = false;
+/// A2 dumbbell: the paper's own, from the scripts released with El Topo
+/// (talpa/sisc-scripts/mc-params-{1,2,3}.txt and talpa/geometryinit.cpp,
+/// signed_distance_dumbbell): balls of radius 0.3 centred at x = ±0.5 and a cylinder of radius
+/// 0.2 between the centres, joined without a blend (φ = min(balls, cylinder)); the reference
+/// grid is [−1, 1] × [−0.5, 0.5]² at Δx = 0.01 (the 200×100×100 of §4.2). The handle pinches
+/// at t ≈ 0.022 (the paper's Fig. 4.3 shows t = 0.0219); a ball of 0.3 alone would vanish at
+/// R²/4 = 0.0225, so at t = 0.025 two drops of radius ≈ 0.09 remain, whose radius falls at
+/// 2/R ≈ 22 m/s: a lag of 5e-5 s is an error of 1e-3 m.
+inline constexpr double DUMBBELL_BULB_RADIUS = 0.3;
+inline constexpr double DUMBBELL_SEPARATION = 1.0;
+inline constexpr double DUMBBELL_HANDLE_RADIUS = 0.2;
+inline constexpr double DUMBBELL_BLEND_RADIUS = 0.0;
 inline constexpr double DUMBBELL_END = 0.025;  ///< s, the paper's comparison time
 /// A2 dumbbell meshes: ξ in quick and full mode.
 inline constexpr double A2_QUICK_XI[] = {0.04};
@@ -50,10 +69,10 @@ inline constexpr double A2_FULL_XI[] = {0.04, 0.02, 0.01};
 /// Primary reference: the axisymmetric level-set solution on a meridian grid
 /// (tracker::AxisymmetricMcfReference), cell sizes (m) coarse then fine. Errors are measured
 /// against the fine one; the coarse one shows the reference's own convergence (second order:
-/// the fine one's error is about a third of their difference). Quick: 3 s in all; full: about
-/// 20 s and 140 s, with the fine reference's error (≈ 4e-6 at the pinched tips, 1e-6 elsewhere)
-/// below the paper's finest error.
-inline constexpr double A2_AXISYMMETRIC_DX_QUICK[] = {0.01, 0.005};
+/// the fine one's error is about a third of their difference). Quick: 2 s and 14 s (at Δx =
+/// 0.01 and 0.005 the two grids differed by 7.5e-4 on the paper's small final drops, too much
+/// to measure a ξ = 0.04 mesh; at 0.005 and 0.0025 by 2.0e-4); full: 23 s and 109 s.
+inline constexpr double A2_AXISYMMETRIC_DX_QUICK[] = {0.005, 0.0025};
 inline constexpr double A2_AXISYMMETRIC_DX_FULL[] = {0.0025, 0.00125};
 /// Second reference, kept for comparison (issue #5 asks for an OpenVDB level set): the 3-D
 /// narrow-band solution (coupling::LevelSetReference), coarse then fine voxel sizes (m). Its

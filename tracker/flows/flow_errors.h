@@ -16,6 +16,11 @@
 ///     vertex L∞ = max over live vertices of |φ(xᵥ)|,
 ///     vertex L1 = Σᵥ Aᵥ |φ(xᵥ)| / Σᵥ Aᵥ,  Aᵥ = one third of the areas of v's live triangles.
 ///
+/// and the same vertex samples signed (φ > 0 outside): max φ, min φ and Σᵥ Aᵥ φ(xᵥ) / Σᵥ Aᵥ.
+/// The paper's released code (El Topo, talpa/drivers/meancurvature.cpp) reports its Table 4.3
+/// "L∞" and "L1" as these signed max and mean, so inside and outside errors cancel in its L1
+/// and vertices inside the reference do not count in its L∞.
+///
 /// The sampled measures include the polygonal mesh's own chord error (about ℓ²/(12R) on
 /// average for a sphere mesh with vertices on the sphere); the vertex measures do not.
 
