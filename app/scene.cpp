@@ -18,6 +18,9 @@ using Vec3 = Eigen::Vector3d;
 const std::vector<std::string> FLOW_TYPES = {"fluid",          "enright",    "normal_speed",
                                              "mean_curvature", "curl_noise", "none"};
 const std::vector<std::string> NORMAL_SPEED_METHODS = {"face_offsetting", "vertex_normals"};
+const std::vector<std::pair<std::string, tracker::MeanCurvatureIntegrator>>
+    MEAN_CURVATURE_INTEGRATORS = {{"forward_euler", tracker::MeanCurvatureIntegrator::forward_euler},
+                                  {"heun", tracker::MeanCurvatureIntegrator::heun}};
 const std::vector<std::string> EXACT_TYPES = {"none", "two_sphere_normal_flow",
                                               "sphere_mean_curvature"};
 
@@ -201,14 +204,17 @@ void visit_fields(V& v, FlowOptions& o) {
     v.choice("type", o.type, FLOW_TYPES,
              "what moves the surface: `fluid` (coupled Navier–Stokes), `enright` (paper §4.3 "
              "deformation test, RK4), `normal_speed` (§4.1), `mean_curvature` (§4.2, CFL-limited "
-             "forward Euler), `curl_noise` (§4.3, RK4), `none`");
+             "forward Euler or Heun), `curl_noise` (§4.3, RK4), `none`");
     v.number("period", o.period, Range::positive(), "s",
              "Enright period T; the field is modulated by sin(2πt/T)");
     v.section("normal_speed", "motion in the normal direction (type normal_speed)",
               [&](auto& r) { visit_fields(r, o.normal_speed); });
     v.section("mean_curvature", "motion by mean curvature (type mean_curvature)", [&](auto& r) {
         r.number("cfl_number", o.mean_curvature.cfl_number, Range{0.0, 1.0, true, false}, "",
-                 "forward-Euler step ≤ cfl_number · (shortest edge)², also capped by /time/dt");
+                 "step ≤ cfl_number · (shortest edge)², also capped by /time/dt");
+        enum_field(r, "integrator", o.mean_curvature.integrator, MEAN_CURVATURE_INTEGRATORS,
+                   "`forward_euler` (the paper's) or `heun` (second order in time, two curvature "
+                   "evaluations per step, same stability limit)");
     });
     v.section("curl_noise", "divergence-free pseudorandom field (type curl_noise)",
               [&](auto& r) { visit_fields(r, o.curl_noise); });
@@ -311,6 +317,10 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
     v.boolean("smoothing_onto_fitted_surface", o.smoothing_onto_fitted_surface,
               "smoothing moves smooth vertices along a fitted quadratic surface instead of "
               "volume-neutrally in the tangent plane (more accurate shape; not volume-neutral)");
+    v.boolean("collapse_preserves_volume", o.collapse_preserves_volume,
+              "collapses lift the new vertex until the enclosed volume is kept exactly (off: it "
+              "stays at the butterfly point, on the smooth surface; shrinking shapes then keep "
+              "their vertices on the surface instead of drifting outwards)");
     v.boolean("smoothing_holds_colliding_vertices", o.smoothing_holds_colliding_vertices,
               "with collision safety, a smoothing move that may collide keeps its vertices in "
               "place instead of pushing the other sheet away (keeps the volume of thin folded "

@@ -120,6 +120,12 @@ TEST(Scene, GeometricFlowErrorsNameTheJsonPath) {
     EXPECT_NE(error_with(R"("flow": {"type": "mean_curvature", "mean_curvature": {"cfl_number": 0}})")
                   .find("/flow/mean_curvature/cfl_number: expected a number in (0, 1]"),
               std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "mean_curvature", "mean_curvature": {"integrator": "rk4"}})")
+                  .find("/flow/mean_curvature/integrator: expected one of"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("tracker": {"remesh": {"collapse_preserves_volume": 1}})")
+                  .find("/tracker/remesh/collapse_preserves_volume: expected"),
+              std::string::npos);
     EXPECT_NE(error_with(R"("flow": {"type": "curl_noise", "curl_noise": {"seed": -1}})")
                   .find("/flow/curl_noise/seed: expected an integer"),
               std::string::npos);
