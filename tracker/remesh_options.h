@@ -24,7 +24,8 @@ struct RemeshOptions {
     /// the same factor s = clamp(c / (κ α), min_curvature_size_fraction, 1) where the surface
     /// turns with curvature κ, so edges there turn by at most about c radians (a neck of radius
     /// r keeps about 2π/c edges around it). 0 (the default) keeps α and β everywhere; ≥ 0.
-    /// Experimental, used by no scene or validation case: on the A2 dumbbell at ξ = 0.04
+    /// Experimental, used by no scene or validation case: on an earlier A2 dumbbell (bulbs 0.4,
+    /// handle 0.15, blend 0.05; forward Euler, volume-keeping collapses) at ξ = 0.04
     /// (c = 0.5, s_min = 0.125, graded target lengths) L∞ fell from 2.4e-3 to 1.45e-3 and the
     /// pinch-off came 6e-4 s earlier, nearer the reference; at ξ = 0.02 L∞ stayed at 5.9e-4
     /// (L1 6.4e-5 against 6.6e-5) for twice the time (778 s against 383 s). Before the grading
@@ -76,7 +77,11 @@ struct RemeshOptions {
     /// Collapses move the new vertex from the butterfly (or feature / midpoint) position along
     /// the gradient of the enclosed volume until the collapse keeps the volume exactly: the
     /// butterfly point alone lies on the smooth surface, but the coarser star cuts inside it
-    /// (−0.25 % of the Enright sphere's volume over one period at ξ = 0.02).
+    /// (−0.25 % of the Enright sphere's volume over one period at ξ = 0.02). Off for shape
+    /// accuracy on shrinking surfaces, which collapse edges all the time: each volume-keeping
+    /// collapse lifts a vertex off the surface, and a mean-curvature sphere run to 0.9 of its
+    /// extinction time at ξ = 0.04 lagged by vertex L∞ 2.28e-3 with it, 3.1e-4 without (A2 turns
+    /// it off).
     bool collapse_preserves_volume = true;
     /// Smoothing displacements lose their component along each vertex's volume gradient, so a
     /// vertex moved alone keeps the enclosed volume exactly (the quadric's null space is only
