@@ -23,15 +23,16 @@ struct CotangentSums {
     std::vector<double> mixed_area;
 };
 
-CotangentSums accumulate(const SurfaceMesh& mesh) {
+/// With the vertices at `position(v)` (the mesh's own positions, or predicted ones).
+template <typename Position>
+CotangentSums accumulate(const SurfaceMesh& mesh, const Position& position) {
     const size_t nv = static_cast<size_t>(mesh.num_vertices());
     CotangentSums sums{std::vector<Vec3>(nv, Vec3::Zero()), std::vector<double>(nv, 0.0)};
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
         if (!mesh.triangle_alive(ti))
             continue;
         const Triangle& t = mesh.triangle(ti);
-        const std::array<Vec3, 3> p = {mesh.position(t[0]), mesh.position(t[1]),
-                                       mesh.position(t[2])};
+        const std::array<Vec3, 3> p = {position(t[0]), position(t[1]), position(t[2])};
         const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
         std::array<double, 3> cot{};
         int obtuse_corner = -1;
@@ -69,23 +70,31 @@ CotangentSums accumulate(const SurfaceMesh& mesh) {
     return sums;
 }
 
-}  // namespace
-
-std::vector<double> mixed_voronoi_areas(const SurfaceMesh& mesh) {
-    return accumulate(mesh).mixed_area;
+auto mesh_positions(const SurfaceMesh& mesh) {
+    return [&mesh](int v) -> const Vec3& { return mesh.position(v); };
 }
 
-std::vector<Vec3> mean_curvature_normals(const SurfaceMesh& mesh) {
-    const CotangentSums sums = accumulate(mesh);
+/// K = (1 / 2A) Σ (cot α + cot β)(xᵢ − xⱼ) per vertex from the accumulated sums.
+std::vector<Vec3> curvature_normals(const SurfaceMesh& mesh, const CotangentSums& sums) {
     std::vector<Vec3> k(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
         const size_t i = static_cast<size_t>(vi);
         if (!mesh.vertex_alive(vi) || !(sums.mixed_area[i] > 0.0) || mesh.is_boundary_vertex(vi))
             continue;
-        // K = (1 / 2A) Σ (cot α + cot β)(xᵢ − xⱼ); the per-triangle sum holds Σ cot·(xᵢ − xⱼ).
+        // The per-triangle sum holds Σ cot·(xᵢ − xⱼ).
         k[i] = sums.laplacian_sum[i] / (2.0 * sums.mixed_area[i]);
     }
     return k;
+}
+
+}  // namespace
+
+std::vector<double> mixed_voronoi_areas(const SurfaceMesh& mesh) {
+    return accumulate(mesh, mesh_positions(mesh)).mixed_area;
+}
+
+std::vector<Vec3> mean_curvature_normals(const SurfaceMesh& mesh) {
+    return curvature_normals(mesh, accumulate(mesh, mesh_positions(mesh)));
 }
 
 std::vector<double> mean_curvatures(const SurfaceMesh& mesh) {
@@ -123,11 +132,11 @@ std::vector<Vec3> mean_curvature_displacements(const SurfaceMesh& mesh, double d
     std::vector<Vec3> d = mean_curvature_displacements(mesh, dt);
     if (integrator == MeanCurvatureIntegrator::forward_euler)
         return d;
-    SurfaceMesh predicted = mesh;
-    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
-        if (mesh.vertex_alive(vi))
-            predicted.set_position(vi, mesh.position(vi) + d[static_cast<size_t>(vi)]);
-    const std::vector<Vec3> k = mean_curvature_normals(predicted);
+    // K at the predicted positions x − dt K(x), on the same connectivity.
+    const auto predicted = [&mesh, &d](int v) -> Vec3 {
+        return mesh.position(v) + d[static_cast<size_t>(v)];
+    };
+    const std::vector<Vec3> k = curvature_normals(mesh, accumulate(mesh, predicted));
     for (size_t i = 0; i < d.size(); ++i)
         d[i] = 0.5 * (d[i] - dt * k[i]);
     return d;
