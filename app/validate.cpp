@@ -369,6 +369,8 @@ void case_a2(Context& c) {
     const auto stepper = std::make_shared<tracker::MeanCurvatureStepper>(mcf);
     tracker::TrackerOptions mcf_tracker = paper_tracker_options();
     mcf_tracker.remesh.collapse_preserves_volume = MCF_COLLAPSE_PRESERVES_VOLUME;
+    mcf_tracker.remesh.curvature_edge_fraction = MCF_CURVATURE_EDGE_FRACTION;
+    mcf_tracker.remesh.split_on_fitted_surface = MCF_CURVATURE_EDGE_FRACTION > 0.0;
     {
         const Vec3 center = Vec3::Zero();
         const double t_end = MCF_SPHERE_TIME_FRACTION * MCF_SPHERE_RADIUS * MCF_SPHERE_RADIUS / 4.0;

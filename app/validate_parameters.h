@@ -50,6 +50,27 @@ inline constexpr bool MCF_HEUN = true;
 /// so the sphere run to 0.9 of its extinction time at ξ = 0.04 lagged by vertex L∞ 2.28e-3
 /// (3.1e-4 without) and the dumbbell by 1.48e-2 (3.95e-3 without, both forward Euler).
 inline constexpr bool MCF_COLLAPSE_PRESERVES_VOLUME = false;
+/// A2 runs refine where the surface turns sharply (RemeshOptions::curvature_edge_fraction c,
+/// with split_on_fitted_surface, which it needs; s_min stays at its default 0.25): edges turn
+/// by at most about c radians, so the thinning neck keeps about 2π/c edges around it instead of
+/// the few that ξ leaves, moves at its true curvature and pinches on time. The error at
+/// t = 0.025 is mostly that time: the retracting tips move at 50–130 m/s after the pinch.
+/// Dumbbell at ξ = 0.04 (quick reference, Δx = 0.0025, whose neck closes at t = 0.021925):
+///
+///   c     pinch     vertex L∞  vertex L1  steps
+///   0     0.022006  1.39e-3    2.0e-4      500   (tip outside: late)
+///   1.0   0.021971  1.01e-3    2.4e-4      878
+///   0.7   0.021957  4.9e-4     2.2e-4     1231   (chosen)
+///   0.5   0.021944  5.35e-4    1.5e-4     1718
+///   0.3   0.021892  1.91e-3    7.1e-4     2850   (tips inside: a neck refined that far meets
+///                                                  the pinch threshold early)
+///
+/// At ξ = 0.02 (full reference) c = 0.7 gave vertex L∞ 1.49e-4, L1 6.7e-5 (signed max 9.1e-5),
+/// c = 0.5 1.69e-4, 8.6e-5 (signed max 1.48e-4, above the paper's 1.44e-4) and c = 0 1.85e-4,
+/// 6.6e-5. The CFL step follows the refined neck's edges, hence the extra steps; the triangle
+/// counts stay those of c = 0. Not in the paper, whose runs keep α and β everywhere. The
+/// sphere is unchanged (it never turns that sharply before t_end).
+inline constexpr double MCF_CURVATURE_EDGE_FRACTION = 0.7;
 /// A2 dumbbell: the paper's own, from the scripts released with El Topo
 /// (talpa/sisc-scripts/mc-params-{1,2,3}.txt and talpa/geometryinit.cpp,
 /// signed_distance_dumbbell): balls of radius 0.3 centred at x = ±0.5 and a cylinder of radius

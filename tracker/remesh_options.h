@@ -24,8 +24,11 @@ struct RemeshOptions {
     /// the same factor s = clamp(c / (κ α), min_curvature_size_fraction, 1) where the surface
     /// turns with curvature κ, so edges there turn by at most about c radians (a neck of radius
     /// r keeps about 2π/c edges around it). 0 (the default) keeps α and β everywhere; ≥ 0.
-    /// Experimental, used by no scene or validation case: on an earlier A2 dumbbell (bulbs 0.4,
-    /// handle 0.15, blend 0.05; forward Euler, volume-keeping collapses) at ξ = 0.04
+    /// A2 (validate and scenes/flows/a2_*.json) uses c = 0.7: on the paper's dumbbell at
+    /// ξ = 0.04 the neck pinched at t = 0.021957 instead of 0.022006 (reference 0.021925) and
+    /// vertex L∞ at t = 0.025 fell from 1.39e-3 to 4.9e-4 (app/validate_parameters.h has the
+    /// other c). On an earlier A2 dumbbell (bulbs 0.4, handle 0.15, blend 0.05; forward
+    /// Euler, volume-keeping collapses) at ξ = 0.04
     /// (c = 0.5, s_min = 0.125, graded target lengths) L∞ fell from 2.4e-3 to 1.45e-3 and the
     /// pinch-off came 6e-4 s earlier, nearer the reference; at ξ = 0.02 L∞ stayed at 5.9e-4
     /// (L1 6.4e-5 against 6.6e-5) for twice the time (778 s against 383 s). Before the grading
