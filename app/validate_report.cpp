@@ -192,7 +192,8 @@ void report_a2(std::ostringstream& md, Json& results) {
        << (MCF_HEUN ? "Heun's method" : "forward Euler")
        << " with the CFL step, α = 1.5ξ, β = 0.5ξ, γ = 0.1ξ³"
        << (MCF_COLLAPSE_PRESERVES_VOLUME ? "" : ", collapses on the smooth surface")
-       << mcf_sizing_text() << ".\n\n| ξ | R₀ | t | steps | exact R(t) | L∞ | L1 | vertex L∞ | vertex L∞ / R | "
+       << mcf_sizing_text()
+       << ".\n\n| ξ | R₀ | t | steps | exact R(t) | L∞ | L1 | vertex L∞ | vertex L∞ / R | "
           "volume change % | exact volume change % | max intersecting pairs "
           "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const Json& r : select(results["runs"], "A2", "sphere"))
