@@ -23,7 +23,6 @@ SurfaceError surface_error(const SurfaceMesh& mesh,
                            const SurfaceErrorOptions& options) {
     options.validate();
     SurfaceError error;
-    std::vector<double> vertex_phi(static_cast<size_t>(mesh.num_vertices()), 0.0);
     std::vector<double> vertex_signed(static_cast<size_t>(mesh.num_vertices()), 0.0);
     error.vertex_max_signed = -std::numeric_limits<double>::infinity();
     error.vertex_min_signed = std::numeric_limits<double>::infinity();
@@ -32,7 +31,6 @@ SurfaceError surface_error(const SurfaceMesh& mesh,
             continue;
         const double signed_phi = signed_distance(mesh.position(vi));
         const double phi = std::abs(signed_phi);
-        vertex_phi[static_cast<size_t>(vi)] = phi;
         vertex_signed[static_cast<size_t>(vi)] = signed_phi;
         error.vertex_max_signed = std::max(error.vertex_max_signed, signed_phi);
         error.vertex_min_signed = std::min(error.vertex_min_signed, signed_phi);
@@ -77,8 +75,9 @@ SurfaceError surface_error(const SurfaceMesh& mesh,
         weighted_sum += area * sum / (m * m);
         error.area += area;
         for (int vi : t) {
-            vertex_weighted_sum += area / 3.0 * vertex_phi[static_cast<size_t>(vi)];
-            vertex_signed_sum += area / 3.0 * vertex_signed[static_cast<size_t>(vi)];
+            const double signed_phi = vertex_signed[static_cast<size_t>(vi)];
+            vertex_weighted_sum += area / 3.0 * std::abs(signed_phi);
+            vertex_signed_sum += area / 3.0 * signed_phi;
         }
     }
     error.l1 = error.area > 0.0 ? weighted_sum / error.area : 0.0;
