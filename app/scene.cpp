@@ -279,7 +279,7 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
              "γ: largest volume change of one flip or collapse");
     v.number("curvature_edge_fraction", o.curvature_edge_fraction, Range::non_negative(),
              "radians",
-             "experimental curvature-adaptive sizing (not in the paper; needs "
+             "curvature-adaptive sizing (not in the paper; A2 uses 0.7; needs "
              "split_on_fitted_surface): where the surface has curvature κ, α and β shrink so edges "
              "turn by at most this angle (α·s, β·s with s = min(1, c/(κα))); 0 keeps α and β");
     v.number("min_curvature_size_fraction", o.min_curvature_size_fraction,
