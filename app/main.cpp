@@ -8,11 +8,13 @@
 #include "app/validate_fluid.h"
 
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -42,12 +44,13 @@ const char* USAGE =
     "        (keeping its time per frame); --max-steps N stops after N time steps (smoke tests).\n"
     "        Ctrl-C stops after the current step; every file\n"
     "        already written is complete.\n"
-    "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4|B1|B2|B3|B4|B5]...\n"
+    "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4|B1|B2|B3|B4|B5]... [--xi X]...\n"
     "        run the validation cases — A: the paper's geometric flows, B: two-phase flow with\n"
     "        surface tension (quick: coarse, minutes; full: the references' resolutions, hours)\n"
     "        — and write report.md, results.json and plots into DIR\n"
-    "        (default: validation/); --case runs only the named cases (repeatable); exit code 1\n"
-    "        if a run failed or intersected\n"
+    "        (default: validation/); --case runs only the named cases (repeatable);\n"
+    "        --xi runs only the part-A runs at edge length X m (repeatable, e.g.\n"
+    "        --full --case A2 --xi 0.01); exit code 1 if a run failed or intersected\n"
     "  scene-reference\n"
     "        print every scene key with its type, default, unit and meaning (Markdown)\n"
     "\n"
@@ -71,6 +74,18 @@ int parse_positive_int(const std::string& flag, const std::string& text) {
         return static_cast<int>(v);
     } catch (const std::exception&) {
         throw UsageError(flag + ": expected a whole number from 1 to 1000000, got '" + text + "'");
+    }
+}
+
+double parse_positive_length(const std::string& flag, const std::string& text) {
+    try {
+        size_t used = 0;
+        const double v = std::stod(text, &used);
+        if (used != text.size() || !(v > 0.0) || !std::isfinite(v))
+            throw std::out_of_range(text);
+        return v;
+    } catch (const std::exception&) {
+        throw UsageError(flag + ": expected a positive length in metres, got '" + text + "'");
     }
 }
 
@@ -153,8 +168,15 @@ int dispatch(int argc, char** argv) {
                     throw UsageError("validate: --case expects A1, A2, A3, A4 or B1 … B5, got '" +
                                      id + "'");
                 options.cases.push_back(id);
-            } else
+            } else if (args[i] == "--xi" && i + 1 < args.size())
+                options.xis.push_back(parse_positive_length("--xi", args[++i]));
+            else
                 throw UsageError("validate: unknown or incomplete option " + args[i]);
+        }
+        try {
+            check_validate_options(options);
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(e.what());
         }
         return run_validation(options);
     }

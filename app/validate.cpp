@@ -31,6 +31,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -278,9 +279,54 @@ Json error_json(const tracker::SurfaceError& e) {
 /// log(e_coarse / e_fine) / log(ξ_coarse / ξ_fine).
 // ---- Cases ------------------------------------------------------------------------------------
 
+/// The resolutions ξ (m) each part-A case runs, in order; A1's and A4's include their
+/// collision-safety-off runs.
+std::vector<double> a1_xis(bool full) {
+    return full ? std::vector<double>{0.04, 0.02, 0.01} : std::vector<double>{0.04};
+}
+std::vector<double> a2_sphere_xis(bool full) {
+    return full ? std::vector<double>{0.04, 0.02} : std::vector<double>{0.04};
+}
+std::vector<double> a2_dumbbell_xis(bool full) {
+    return full ? std::vector<double>(std::begin(A2_FULL_XI), std::end(A2_FULL_XI))
+                : std::vector<double>(std::begin(A2_QUICK_XI), std::end(A2_QUICK_XI));
+}
+std::vector<double> a3_xis(bool full) {
+    return full ? std::vector<double>{0.02, 0.01} : std::vector<double>{0.02};
+}
+std::vector<double> case_xis(const std::string& id, bool full) {
+    std::vector<double> xis;
+    if (id == "A1") {
+        xis = a1_xis(full);
+        xis.push_back(A1_UNSAFE_XI);
+    } else if (id == "A2") {
+        xis = a2_sphere_xis(full);
+        for (double xi : a2_dumbbell_xis(full))
+            xis.push_back(xi);
+    } else if (id == "A3") {
+        xis = a3_xis(full);
+    } else if (id == "A4") {
+        xis = {CURL_XI};
+        if (full)
+            xis.insert(xis.end(), std::begin(CURL_XI_FULL), std::end(CURL_XI_FULL));
+    }
+    return xis;
+}
+
+bool same_xi(double a, double b) {
+    return std::abs(a - b) <= 1e-6 * std::max(a, b);
+}
+
 struct Context {
     bool full = false;
     bool quiet = false;
+    std::vector<double> xis;  ///< ValidateOptions::xis: empty runs every resolution
+
+    /// Whether a run at resolution `xi` is selected.
+    bool runs_xi(double xi) const {
+        return xis.empty() ||
+               std::any_of(xis.begin(), xis.end(), [xi](double x) { return same_xi(x, xi); });
+    }
     Json runs = Json::array();
     bool all_ok = true;
     std::vector<std::string> failures;
@@ -314,8 +360,7 @@ void case_a1(Context& c) {
     const auto shape =
         tracker::make_union({tracker::make_sphere(flow.center0, flow.initial_radius),
                              tracker::make_sphere(flow.center1, flow.initial_radius)});
-    const std::vector<double> xis =
-        c.full ? std::vector<double>{0.04, 0.02, 0.01} : std::vector<double>{0.04};
+    const std::vector<double> xis = a1_xis(c.full);
     struct Method {
         const char* label;
         std::shared_ptr<const tracker::FlowStepper> stepper;
@@ -325,6 +370,8 @@ void case_a1(Context& c) {
         {"vertex normals", std::make_shared<tracker::VertexNormalStepper>(speed)}};
     for (const Method& m : methods)
         for (double xi : xis) {
+            if (!c.runs_xi(xi))
+                continue;
             RunSpec s;
             s.case_id = "A1";
             s.label = m.label;
@@ -344,6 +391,8 @@ void case_a1(Context& c) {
             j["error"] = error_json(tracker::two_sphere_normal_flow_error(r.final_mesh, flow, r.t));
             c.add(std::move(j), r);
         }
+    if (!c.runs_xi(A1_UNSAFE_XI))
+        return;
     RunSpec s;
     s.case_id = "A1";
     s.label = A1_UNSAFE_LABEL;
@@ -374,9 +423,9 @@ void case_a2(Context& c) {
     {
         const Vec3 center = Vec3::Zero();
         const double t_end = MCF_SPHERE_TIME_FRACTION * MCF_SPHERE_RADIUS * MCF_SPHERE_RADIUS / 4.0;
-        const std::vector<double> xis =
-            c.full ? std::vector<double>{0.04, 0.02} : std::vector<double>{0.04};
-        for (double xi : xis) {
+        for (double xi : a2_sphere_xis(c.full)) {
+            if (!c.runs_xi(xi))
+                continue;
             RunSpec s;
             s.case_id = "A2";
             s.label = "sphere";
@@ -395,72 +444,74 @@ void case_a2(Context& c) {
             c.add(std::move(j), r);
         }
     }
-    // Dumbbell: the references first (coarse and fine grid each), then each mesh against them.
+    // Dumbbell: the references (axisymmetric and OpenVDB, coarse and fine grid each) are
+    // computed on a second thread while the meshes run; then each mesh is measured against them.
+    std::vector<double> dumbbell_xis;
+    for (double xi : a2_dumbbell_xis(c.full))
+        if (c.runs_xi(xi))
+            dumbbell_xis.push_back(xi);
+    if (dumbbell_xis.empty())
+        return;
     const tracker::ShapePtr dumbbell =
         tracker::make_dumbbell(Vec3::Zero(), DUMBBELL_BULB_RADIUS, DUMBBELL_SEPARATION,
                                DUMBBELL_HANDLE_RADIUS, DUMBBELL_BLEND_RADIUS);
     const double* axi_dx = c.full ? A2_AXISYMMETRIC_DX_FULL : A2_AXISYMMETRIC_DX_QUICK;
-    std::vector<tracker::AxisymmetricMcfReference> axis_refs;
-    Json axi_json = Json::array();
-    for (int i = 0; i < 2; ++i) {
-        tracker::AxisymmetricMcfOptions o;
-        o.voxel_size = axi_dx[i];
-        o.end_time = DUMBBELL_END;
-        axis_refs.emplace_back(*dumbbell, Vec3::Zero(), Vec3::UnitX(), o);
-        const tracker::AxisymmetricMcfStats& st = axis_refs.back().stats();
-        axi_json.push_back({{"voxel_size", o.voxel_size},
-                            {"time_step", st.time_step},
-                            {"steps", st.steps},
-                            {"reinit_interval", o.reinit_interval},
-                            {"band_half_width", axis_refs.back().band_half_width()},
-                            {"grid", {st.axial_cells, st.radial_cells}},
-                            {"final_band_cells", st.final_band_cells},
-                            {"seconds", st.seconds}});
-        if (!c.quiet)
-            std::fprintf(stderr,
-                         "  A2 dumbbell axisymmetric reference Δx=%g: %ld steps of %g s, %d×%d "
-                         "grid, %lld band cells, %.1f s\n",
-                         o.voxel_size, st.steps, st.time_step, st.axial_cells, st.radial_cells,
-                         st.final_band_cells, st.seconds);
-    }
     const double* ref_dx = c.full ? A2_REFERENCE_DX_FULL : A2_REFERENCE_DX_QUICK;
-    std::vector<coupling::LevelSetReference> refs;
-    Json ref_json = Json::array();
-    for (int i = 0; i < 2; ++i) {
-        coupling::LevelSetReferenceOptions o;
-        o.voxel_size = ref_dx[i];
-        o.end_time = DUMBBELL_END;
-        refs.emplace_back(*dumbbell, o);
-        const coupling::LevelSetReferenceStats& st = refs.back().stats();
-        ref_json.push_back({{"voxel_size", o.voxel_size},
-                            {"time_step", st.time_step},
-                            {"steps", st.steps},
-                            {"renormalization_iterations", o.renormalization_iterations},
-                            {"band_half_width", refs.back().band_half_width()},
-                            {"initial_voxels", st.initial_voxels},
-                            {"final_voxels", st.final_voxels},
-                            {"seconds", st.seconds}});
-        if (!c.quiet)
-            std::fprintf(stderr,
-                         "  A2 dumbbell OpenVDB level-set reference Δx=%g: %ld steps of %g s, "
-                         "%lld → %lld band voxels, %.1f s\n",
-                         o.voxel_size, st.steps, st.time_step, st.initial_voxels, st.final_voxels,
-                         st.seconds);
-    }
-    const auto phi_of = [](const auto& ref) {
-        return [&ref](const Vec3& x) { return ref.distance(x); };
+    struct References {
+        std::vector<tracker::AxisymmetricMcfReference> axis;
+        Json axis_json = Json::array();
+        std::vector<coupling::LevelSetReference> vdb;
+        Json vdb_json = Json::array();
     };
-    const auto difference_of = [](const auto& coarse, const auto& fine) {
-        return [&coarse, &fine](const Vec3& x) { return coarse.distance(x) - fine.distance(x); };
-    };
-    const double axi_trusted =
-        axis_refs.back().band_half_width() - A2_AXISYMMETRIC_TRUSTED_MARGIN_VOXELS * axi_dx[1];
-    const double trusted =
-        refs.back().band_half_width() - A2_REFERENCE_TRUSTED_MARGIN_VOXELS * ref_dx[1];
-    const std::vector<double> xis =
-        c.full ? std::vector<double>(std::begin(A2_FULL_XI), std::end(A2_FULL_XI))
-               : std::vector<double>(std::begin(A2_QUICK_XI), std::end(A2_QUICK_XI));
-    for (double xi : xis) {
+    const bool quiet = c.quiet;
+    std::future<References> pending = std::async(std::launch::async, [=] {
+        References refs;
+        for (int i = 0; i < 2; ++i) {
+            tracker::AxisymmetricMcfOptions o;
+            o.voxel_size = axi_dx[i];
+            o.end_time = DUMBBELL_END;
+            refs.axis.emplace_back(*dumbbell, Vec3::Zero(), Vec3::UnitX(), o);
+            const tracker::AxisymmetricMcfStats& st = refs.axis.back().stats();
+            refs.axis_json.push_back({{"voxel_size", o.voxel_size},
+                                      {"time_step", st.time_step},
+                                      {"steps", st.steps},
+                                      {"reinit_interval", o.reinit_interval},
+                                      {"band_half_width", refs.axis.back().band_half_width()},
+                                      {"grid", {st.axial_cells, st.radial_cells}},
+                                      {"final_band_cells", st.final_band_cells},
+                                      {"seconds", st.seconds}});
+            if (!quiet)
+                std::fprintf(stderr,
+                             "  A2 dumbbell axisymmetric reference Δx=%g: %ld steps of %g s, "
+                             "%d×%d grid, %lld band cells, %.1f s\n",
+                             o.voxel_size, st.steps, st.time_step, st.axial_cells, st.radial_cells,
+                             st.final_band_cells, st.seconds);
+        }
+        for (int i = 0; i < 2; ++i) {
+            coupling::LevelSetReferenceOptions o;
+            o.voxel_size = ref_dx[i];
+            o.end_time = DUMBBELL_END;
+            refs.vdb.emplace_back(*dumbbell, o);
+            const coupling::LevelSetReferenceStats& st = refs.vdb.back().stats();
+            refs.vdb_json.push_back({{"voxel_size", o.voxel_size},
+                                     {"time_step", st.time_step},
+                                     {"steps", st.steps},
+                                     {"renormalization_iterations", o.renormalization_iterations},
+                                     {"band_half_width", refs.vdb.back().band_half_width()},
+                                     {"initial_voxels", st.initial_voxels},
+                                     {"final_voxels", st.final_voxels},
+                                     {"seconds", st.seconds}});
+            if (!quiet)
+                std::fprintf(stderr,
+                             "  A2 dumbbell OpenVDB level-set reference Δx=%g: %ld steps of %g "
+                             "s, %lld → %lld band voxels, %.1f s\n",
+                             o.voxel_size, st.steps, st.time_step, st.initial_voxels,
+                             st.final_voxels, st.seconds);
+        }
+        return refs;
+    });
+    std::vector<RunResult> runs;
+    for (double xi : dumbbell_xis) {
         RunSpec s;
         s.case_id = "A2";
         s.label = "dumbbell";
@@ -470,7 +521,20 @@ void case_a2(Context& c) {
         s.stepper = stepper;
         s.t_end = DUMBBELL_END;
         s.max_dt = MCF_MAX_DT;
-        const RunResult r = run_tracked(s, c.quiet);
+        runs.push_back(run_tracked(s, c.quiet));
+    }
+    const References refs = pending.get();
+    const auto phi_of = [](const auto& ref) {
+        return [&ref](const Vec3& x) { return ref.distance(x); };
+    };
+    const auto difference_of = [](const auto& coarse, const auto& fine) {
+        return [&coarse, &fine](const Vec3& x) { return coarse.distance(x) - fine.distance(x); };
+    };
+    const double axi_trusted =
+        refs.axis.back().band_half_width() - A2_AXISYMMETRIC_TRUSTED_MARGIN_VOXELS * axi_dx[1];
+    const double trusted =
+        refs.vdb.back().band_half_width() - A2_REFERENCE_TRUSTED_MARGIN_VOXELS * ref_dx[1];
+    for (const RunResult& r : runs) {
         Json j = run_json(r);
         double pinch = -1.0;
         for (size_t i = 0; i < r.series_components.size(); ++i)
@@ -483,23 +547,23 @@ void case_a2(Context& c) {
         // L∞, L1 as for the analytic flows (flow_errors.h), with each reference's φ. The
         // axisymmetric reference is the primary one ("error").
         const tracker::SurfaceError error =
-            tracker::surface_error(r.final_mesh, phi_of(axis_refs.back()));
+            tracker::surface_error(r.final_mesh, phi_of(refs.axis.back()));
         j["error"] = error_json(error);
         j["error_within_reference_band"] = error.linf < axi_trusted;
         j["error_coarse_reference"] =
-            error_json(tracker::surface_error(r.final_mesh, phi_of(axis_refs.front())));
+            error_json(tracker::surface_error(r.final_mesh, phi_of(refs.axis.front())));
         j["reference_difference"] = error_json(tracker::surface_error(
-            r.final_mesh, difference_of(axis_refs.front(), axis_refs.back())));
-        j["reference"] = axi_json;
+            r.final_mesh, difference_of(refs.axis.front(), refs.axis.back())));
+        j["reference"] = refs.axis_json;
         const tracker::SurfaceError vdb_error =
-            tracker::surface_error(r.final_mesh, phi_of(refs.back()));
+            tracker::surface_error(r.final_mesh, phi_of(refs.vdb.back()));
         j["openvdb_error"] = error_json(vdb_error);
         j["openvdb_error_within_reference_band"] = vdb_error.linf < trusted;
         j["openvdb_error_coarse_reference"] =
-            error_json(tracker::surface_error(r.final_mesh, phi_of(refs.front())));
+            error_json(tracker::surface_error(r.final_mesh, phi_of(refs.vdb.front())));
         j["openvdb_reference_difference"] = error_json(
-            tracker::surface_error(r.final_mesh, difference_of(refs.front(), refs.back())));
-        j["openvdb_reference"] = ref_json;
+            tracker::surface_error(r.final_mesh, difference_of(refs.vdb.front(), refs.vdb.back())));
+        j["openvdb_reference"] = refs.vdb_json;
         c.add(std::move(j), r);
     }
 }
@@ -515,9 +579,9 @@ void case_a3(Context& c) {
     };
     const auto holder =
         std::make_shared<Holder>(Holder{field, tracker::VelocityFieldStepper(*field)});
-    const std::vector<double> xis =
-        c.full ? std::vector<double>{0.02, 0.01} : std::vector<double>{0.02};
-    for (double xi : xis) {
+    for (double xi : a3_xis(c.full)) {
+        if (!c.runs_xi(xi))
+            continue;
         RunSpec s;
         s.case_id = "A3";
         s.label = "Enright";
@@ -569,6 +633,8 @@ void case_a4(Context& c) {
         multiscale = field(CURL_MULTISCALE_OCTAVES, CURL_MULTISCALE_RMS_SPEED);
     }
     for (const auto& [safety, xi, thin_sheet_sizing, three_octaves] : runs) {
+        if (!c.runs_xi(xi))
+            continue;
         RunSpec s;
         s.case_id = "A4";
         s.label = !safety             ? "curl noise, collision safety off"
@@ -605,6 +671,35 @@ void case_a4(Context& c) {
 
 }  // namespace
 
+void check_validate_options(const ValidateOptions& options) {
+    const auto wanted = [&](const char* id) {
+        return options.cases.empty() ||
+               std::find(options.cases.begin(), options.cases.end(), id) != options.cases.end();
+    };
+    for (const std::string& id : options.cases)
+        if (!is_fluid_case(id) && id != "A1" && id != "A2" && id != "A3" && id != "A4")
+            throw std::invalid_argument("validate: unknown case '" + id +
+                                        "' (expected A1, A2, A3, A4 or B1 … B5)");
+    for (double xi : options.xis) {  // each requested ξ must be one a selected case runs
+        std::vector<double> offered;
+        for (const char* id : {"A1", "A2", "A3", "A4"})
+            if (wanted(id))
+                for (double x : case_xis(id, options.full))
+                    if (std::find(offered.begin(), offered.end(), x) == offered.end())
+                        offered.push_back(x);
+        if (std::none_of(offered.begin(), offered.end(),
+                         [xi](double x) { return same_xi(x, xi); })) {
+            std::string list;
+            for (double x : offered)
+                list += (list.empty() ? "" : ", ") + format_number(x, "%g");
+            throw std::invalid_argument(
+                "validate: --xi " + format_number(xi, "%g") + " is not a resolution of the " +
+                "selected part-A cases in " + (options.full ? "full" : "quick") + " mode (" +
+                (list.empty() ? std::string("none selected") : "they run " + list) + ")");
+        }
+    }
+}
+
 int run_validation(const ValidateOptions& options) {
     namespace fs = std::filesystem;
     const auto wall_start = Clock::now();
@@ -620,15 +715,13 @@ int run_validation(const ValidateOptions& options) {
         return options.cases.empty() ||
                std::find(options.cases.begin(), options.cases.end(), id) != options.cases.end();
     };
+    check_validate_options(options);
     std::vector<std::string> fluid_cases;  // part B (app/validate_fluid.h)
-    for (const std::string& id : options.cases) {
+    for (const std::string& id : options.cases)
         if (is_fluid_case(id))
             fluid_cases.push_back(id);
-        else if (id != "A1" && id != "A2" && id != "A3" && id != "A4")
-            throw std::invalid_argument("validate: unknown case '" + id +
-                                        "' (expected A1, A2, A3, A4 or B1 … B5)");
-    }
     const bool any_fluid_case = options.cases.empty() || !fluid_cases.empty();
+    c.xis = options.xis;
     if (wanted("A1"))
         case_a1(c);
     if (wanted("A2"))

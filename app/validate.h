@@ -21,7 +21,15 @@ struct ValidateOptions {
     /// Cases to run ("A1", "A2", "A3", "A4"; A5 is timed on the A1 runs; "B1" … "B5": part B,
     /// two-phase flow, app/validate_fluid.h); empty: all.
     std::vector<std::string> cases;
+    /// Resolutions ξ (m) of part A to run, each one of the selected cases' own (e.g. 0.01 with
+    /// --full for the finest row only); empty: all. A value no selected case runs is an
+    /// std::invalid_argument before anything runs. Part B has no ξ and ignores this.
+    std::vector<double> xis;
 };
+
+/// Throws std::invalid_argument, naming the option, if `options` asks for an unknown case or a
+/// ξ that no selected case runs. run_validation() calls it before running anything.
+void check_validate_options(const ValidateOptions& options);
 
 /// Runs the validation cases and writes the report. Returns a process exit code: 0 when every
 /// run finished and every collision-safe run stayed intersection-free at every step, 1

@@ -99,6 +99,24 @@ TEST_F(CliTest, BadFramesValueIsBadInput) {
     EXPECT_NE(o.output.find("--frames: expected a whole number"), std::string::npos);
 }
 
+TEST_F(CliTest, ValidateXiThatNoSelectedCaseRunsIsBadInput) {
+    // Quick A2 runs only ξ = 0.04; the check runs before anything is computed.
+    const Outcome o =
+        run_meniscus("validate --quick --case A2 --xi 0.01 --out " + (m_dir / "v").string());
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("--xi 0.01 is not a resolution"), std::string::npos) << o.output;
+    EXPECT_NE(o.output.find("they run 0.04"), std::string::npos) << o.output;
+    EXPECT_FALSE(fs::exists(m_dir / "v" / "report.md"));
+}
+
+TEST_F(CliTest, ValidateBadXiValueIsBadInput) {
+    for (const char* value : {"fine", "-0.01", "0", "0.01m"}) {
+        const Outcome o = run_meniscus(std::string("validate --xi ") + value);
+        EXPECT_EQ(o.exit_code, 2) << value;
+        EXPECT_NE(o.output.find("--xi: expected a positive length"), std::string::npos) << value;
+    }
+}
+
 TEST_F(CliTest, MissingSceneFileNamesTheFile) {
     const Outcome o = run_meniscus((m_dir / "nope.json").string());
     EXPECT_EQ(o.exit_code, 2);  // unknown command (a path is not a command)

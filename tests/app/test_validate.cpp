@@ -13,11 +13,13 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace {
 
+using meniscus::app::check_validate_options;
 using meniscus::app::run_validation;
 using meniscus::app::ValidateOptions;
 using Json = nlohmann::json;
@@ -276,6 +278,54 @@ TEST_F(QuickValidation, PartBMergeSceneKeepsPhaseVolumes) {
         EXPECT_NE(s_report.find(heading), std::string::npos) << heading;
     EXPECT_NE(s_report.find("| cells per D | steps | fitted period (ms) | Lamb (ms)"),
               std::string::npos);
+}
+
+TEST(ValidateOptionsCheck, NamesTheXiNoSelectedCaseRunsAndTheOnesTheyDo) {
+    ValidateOptions options;
+    options.cases = {"A2"};
+    options.xis = {0.01};
+    try {
+        check_validate_options(options);  // quick A2: sphere and dumbbell at 0.04 only
+        FAIL() << "expected std::invalid_argument";
+    } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("--xi 0.01"), std::string::npos) << what;
+        EXPECT_NE(what.find("quick mode (they run 0.04)"), std::string::npos) << what;
+    }
+    options.full = true;  // full A2's dumbbell runs 0.04, 0.02 and 0.01
+    EXPECT_NO_THROW(check_validate_options(options));
+    options.cases = {"A3"};
+    options.xis = {0.02, 0.0141};  // A3 runs 0.02 and 0.01; 0.0141 is A4's
+    EXPECT_THROW(check_validate_options(options), std::invalid_argument);
+    options.cases = {"A3", "A4"};
+    EXPECT_NO_THROW(check_validate_options(options));
+    options.cases = {"A6"};
+    options.xis.clear();
+    EXPECT_THROW(check_validate_options(options), std::invalid_argument);
+}
+
+TEST(ValidateXiSelection, RunsOnlyTheRequestedResolution) {
+    // Full A1 at ξ = 0.04 only: the two methods and the run without collision safety, none of
+    // the 0.02 and 0.01 runs (those take minutes).
+    const fs::path out =
+        fs::temp_directory_path() /
+        ("meniscus_test_validate_xi_" + std::to_string(static_cast<long>(::getpid())));
+    fs::remove_all(out);
+    ValidateOptions options;
+    options.full = true;
+    options.cases = {"A1"};
+    options.xis = {0.04};
+    options.out_dir = out.string();
+    options.quiet = true;
+    EXPECT_EQ(run_validation(options), 0);
+    std::ifstream f(out / "results.json");
+    const Json results = Json::parse(f);
+    fs::remove_all(out);
+    ASSERT_EQ(results["runs"].size(), 3u);
+    for (const Json& r : results["runs"]) {
+        EXPECT_EQ(r["case"], "A1");
+        EXPECT_DOUBLE_EQ(r["xi_requested"].get<double>(), 0.04);
+    }
 }
 
 }  // namespace
