@@ -65,11 +65,12 @@ inline constexpr bool MCF_COLLAPSE_PRESERVES_VOLUME = false;
 ///   0.3   0.021892  1.91e-3    7.1e-4     2850   (tips inside: a neck refined that far meets
 ///                                                  the pinch threshold early)
 ///
-/// At ξ = 0.02 (full reference) c = 0.7 gave vertex L∞ 1.49e-4, L1 6.7e-5 (signed max 9.1e-5),
-/// c = 0.5 1.69e-4, 8.6e-5 (signed max 1.48e-4, above the paper's 1.44e-4) and c = 0 1.85e-4,
-/// 6.6e-5. The CFL step follows the refined neck's edges, hence the extra steps; the triangle
-/// counts stay those of c = 0. Not in the paper, whose runs keep α and β everywhere. The
-/// sphere is unchanged (it never turns that sharply before t_end).
+/// At ξ = 0.02 (against the earlier full reference, Δx = 0.00125) c = 0.7 gave vertex L∞
+/// 1.49e-4, L1 6.7e-5 (signed max 9.1e-5), c = 0.5 1.69e-4, 8.6e-5 (signed max 1.48e-4, above
+/// the paper's 1.44e-4) and c = 0 1.85e-4, 6.6e-5. The CFL step follows the refined neck's
+/// edges, hence the extra steps; the triangle counts stay those of c = 0. Not in the paper,
+/// whose runs keep α and β everywhere. The sphere is unchanged (it never turns that sharply
+/// before t_end).
 inline constexpr double MCF_CURVATURE_EDGE_FRACTION = 0.7;
 /// A2 dumbbell: the paper's own, from the scripts released with El Topo
 /// (talpa/sisc-scripts/mc-params-{1,2,3}.txt and talpa/geometryinit.cpp,
@@ -92,9 +93,12 @@ inline constexpr double A2_FULL_XI[] = {0.04, 0.02, 0.01};
 /// against the fine one; the coarse one shows the reference's own convergence (second order:
 /// the fine one's error is about a third of their difference). Quick: 2 s and 14 s (at Δx =
 /// 0.01 and 0.005 the two grids differed by 7.5e-4 on the paper's small final drops, too much
-/// to measure a ξ = 0.04 mesh; at 0.005 and 0.0025 by 2.0e-4); full: 23 s and 109 s.
+/// to measure a ξ = 0.04 mesh; at 0.005 and 0.0025 by 2.0e-4). Full: 130 s and 917 s; the two
+/// differ by 1.3e-5 at most and 3.5e-6 on average at the mesh vertices (at 0.0025 and 0.00125
+/// by 5.5e-5 and 1.5e-5, the size of the paper's ξ = 0.01 row, which they could not measure).
+/// The references are computed on a second thread while the meshes run.
 inline constexpr double A2_AXISYMMETRIC_DX_QUICK[] = {0.005, 0.0025};
-inline constexpr double A2_AXISYMMETRIC_DX_FULL[] = {0.0025, 0.00125};
+inline constexpr double A2_AXISYMMETRIC_DX_FULL[] = {0.00125, 0.000625};
 /// Second reference, kept for comparison (issue #5 asks for an OpenVDB level set): the 3-D
 /// narrow-band solution (coupling::LevelSetReference), coarse then fine voxel sizes (m). Its
 /// own error is ~2e-3 near the pinched tips even at Δx = 0.005; quick mode uses coarse grids
