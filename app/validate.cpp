@@ -669,13 +669,15 @@ void case_a4(Context& c) {
     }
 }
 
+/// Whether `options` selects case `id` (no --case selects every case).
+bool case_selected(const ValidateOptions& options, const char* id) {
+    return options.cases.empty() ||
+           std::find(options.cases.begin(), options.cases.end(), id) != options.cases.end();
+}
+
 }  // namespace
 
 void check_validate_options(const ValidateOptions& options) {
-    const auto wanted = [&](const char* id) {
-        return options.cases.empty() ||
-               std::find(options.cases.begin(), options.cases.end(), id) != options.cases.end();
-    };
     for (const std::string& id : options.cases)
         if (!is_fluid_case(id) && id != "A1" && id != "A2" && id != "A3" && id != "A4")
             throw std::invalid_argument("validate: unknown case '" + id +
@@ -683,7 +685,7 @@ void check_validate_options(const ValidateOptions& options) {
     for (double xi : options.xis) {  // each requested ξ must be one a selected case runs
         std::vector<double> offered;
         for (const char* id : {"A1", "A2", "A3", "A4"})
-            if (wanted(id))
+            if (case_selected(options, id))
                 for (double x : case_xis(id, options.full))
                     if (std::find(offered.begin(), offered.end(), x) == offered.end())
                         offered.push_back(x);
@@ -711,10 +713,6 @@ int run_validation(const ValidateOptions& options) {
     if (!options.quiet)
         std::fprintf(stderr, "meniscus validate (%s) → %s\n", options.full ? "full" : "quick",
                      out.string().c_str());
-    const auto wanted = [&](const char* id) {
-        return options.cases.empty() ||
-               std::find(options.cases.begin(), options.cases.end(), id) != options.cases.end();
-    };
     check_validate_options(options);
     std::vector<std::string> fluid_cases;  // part B (app/validate_fluid.h)
     for (const std::string& id : options.cases)
@@ -722,13 +720,13 @@ int run_validation(const ValidateOptions& options) {
             fluid_cases.push_back(id);
     const bool any_fluid_case = options.cases.empty() || !fluid_cases.empty();
     c.xis = options.xis;
-    if (wanted("A1"))
+    if (case_selected(options, "A1"))
         case_a1(c);
-    if (wanted("A2"))
+    if (case_selected(options, "A2"))
         case_a2(c);
-    if (wanted("A3"))
+    if (case_selected(options, "A3"))
         case_a3(c);
-    if (wanted("A4"))
+    if (case_selected(options, "A4"))
         case_a4(c);
     FluidValidation part_b;
     if (any_fluid_case) {
