@@ -317,6 +317,10 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
     v.boolean("smoothing_onto_fitted_surface", o.smoothing_onto_fitted_surface,
               "smoothing moves smooth vertices along a fitted quadratic surface instead of "
               "volume-neutrally in the tangent plane (more accurate shape; not volume-neutral)");
+    v.integer("smoothing_fit_degree", o.smoothing_fit_degree, Range::between(2, 3), "",
+              "degree of the height field smoothing_onto_fitted_surface fits over each vertex's "
+              "two-ring: 3 keeps vertices drifting across a surface of varying curvature on it "
+              "(A2 uses 3); 2 is a quadratic");
     v.boolean("collapse_preserves_volume", o.collapse_preserves_volume,
               "collapses lift the new vertex until the enclosed volume is kept exactly (off: it "
               "stays at the butterfly point, on the smooth surface; shrinking shapes then keep "

@@ -99,6 +99,13 @@ struct RemeshOptions {
     /// Enright test at ξ = 0.02 it gained 0.9 % volume (1.1 % with split_on_fitted_surface, 0.16 %
     /// with neither). Shape-accuracy runs (A1) turn both on.
     bool smoothing_onto_fitted_surface = false;
+    /// Degree of that fit, 2 or 3 (SurfaceFitOptions::degree). A quadratic fitted where the
+    /// curvature varies has a slope error that a vertex drifting across it turns into a normal
+    /// error first order in the drift: on the A2 dumbbell at ξ = 0.02 fitted quadratic
+    /// smoothing left every vertex outside by t = 0.025 (mean 2.2e-4), and tangent-plane
+    /// smoothing every drop vertex inside (mean −6.6e-5; on a sphere shrunk to R = 0.1 by
+    /// collapses −8.7e-5). The cubic: +3.0e-5 and −6.6e-6. 2 by default (A1 was measured with it).
+    int smoothing_fit_degree = 2;
     /// With collision safety, a smoothing move that may collide holds the vertices of the pair
     /// still (remesh/smooth.h) instead of going through resolve_collisions, whose impulses push
     /// the neighbouring sheets apart: on A4 curl noise (thin folded sheets) that push added

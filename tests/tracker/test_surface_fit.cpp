@@ -157,6 +157,77 @@ TEST(SurfaceFit, FitIsRefusedAcrossAFoldAndExactOnAPlane) {
     EXPECT_FALSE(fitted_vertex_point(fold, 3 * 5 + 2, target).has_value());
 }
 
+/// Graph z = f(x, y) over a (2k + 1)² grid of spacing h centred on the origin, two triangles
+/// per cell; the centre vertex is (2k + 1)·k + k.
+template <typename F>
+SurfaceMesh graph_grid(int k, double h, F f) {
+    const int n = 2 * k + 1;
+    std::vector<Vec3> p;
+    std::vector<Triangle> t;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const double x = (i - k) * h, y = (j - k) * h;
+            p.push_back({x, y, f(x, y)});
+        }
+    for (int i = 0; i + 1 < n; ++i)
+        for (int j = 0; j + 1 < n; ++j) {
+            const int a = i * n + j;
+            t.push_back({a, a + n, a + n + 1});
+            t.push_back({a, a + n + 1, a + 1});
+        }
+    return SurfaceMesh(p, t);
+}
+
+TEST(SurfaceFit, CubicFitKeepsAMovedVertexOnASurfaceOfVaryingCurvature) {
+    // z = x²/2 + 2x³: the curvature grows along x. Fitted over the two-ring of the centre vertex,
+    // a quadratic takes the cubic into its slope, so a vertex moved along x by d leaves the
+    // surface by about that slope error times d (first order in d: it accumulates when
+    // smoothing keeps moving vertices the same way, which drifted the A2 dumbbell outwards).
+    // The cubic is exact on it.
+    const auto f = [](double x, double y) { return 0.5 * x * x + 2.0 * x * x * x + 0.0 * y; };
+    const SurfaceMesh mesh = graph_grid(4, 0.05, f);
+    const int centre = 9 * 4 + 4;
+    SurfaceFitOptions quadratic, cubic;
+    cubic.degree = 3;
+    for (const double d : {0.01, -0.01, 0.02}) {
+        const Vec3 target = mesh.position(centre) + Vec3(d, 0.5 * d, 0.0);
+        const std::optional<Vec3> q = fitted_vertex_point(mesh, centre, target, quadratic);
+        const std::optional<Vec3> c = fitted_vertex_point(mesh, centre, target, cubic);
+        ASSERT_TRUE(q.has_value());
+        ASSERT_TRUE(c.has_value());
+        // Vertical distance to the graph. The frame normal, the one-ring's mean normal, is
+        // tilted slightly off z by the asymmetric ring, and a tilted cubic graph is a cubic only
+        // up to higher-order terms: the cubic misses by 1e-8 … 8e-8.
+        const double quadratic_error = std::abs(q->z() - f(q->x(), q->y()));
+        const double cubic_error = std::abs(c->z() - f(c->x(), c->y()));
+        EXPECT_LT(cubic_error, 2e-7) << "d " << d;
+        EXPECT_LT(cubic_error, 1e-2 * quadratic_error) << "d " << d;
+        // Measured 1.6e-4 (d = ±0.01) and 3.1e-4 (d = 0.02): the slope error times |d|.
+        EXPECT_GT(quadratic_error, 0.5 * std::abs(d) * 0.01) << "d " << d;
+    }
+}
+
+TEST(SurfaceFit, CubicFitFallsBackToTheQuadraticOnSmallPatches) {
+    // Nine vertices cannot determine ten coefficients: the cubic request gives the quadratic.
+    const auto f = [](double x, double y) { return 0.5 * x * x + 0.25 * y * y; };
+    const SurfaceMesh mesh = graph_grid(1, 0.05, f);
+    std::vector<int> all(9);
+    for (int i = 0; i < 9; ++i)
+        all[static_cast<size_t>(i)] = i;
+    std::vector<int> triangles(static_cast<size_t>(mesh.num_triangles()));
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        triangles[static_cast<size_t>(ti)] = ti;
+    SurfaceFitOptions cubic;
+    cubic.degree = 3;
+    const std::optional<SurfacePatch> patch =
+        fit_surface_patch(mesh, all, triangles, Vec3::Zero(), Vec3::UnitZ(), cubic);
+    ASSERT_TRUE(patch.has_value());
+    EXPECT_EQ(patch->coefficients.tail<4>(), (Eigen::Matrix<double, 4, 1>::Zero()));
+    for (int vi = 0; vi < 9; ++vi)
+        EXPECT_NEAR((patch->point_above(mesh.position(vi)) - mesh.position(vi)).norm(), 0.0,
+                    1e-12);
+}
+
 TEST(SurfaceFit, FittedSmoothingKeepsVerticesOnTheSphere) {
     // Twenty smoothing steps on a mesh whose vertices are all on the sphere: with the fit they
     // stay within 1e-5 (measured 4e-6: the fit's own error, not accumulated); moving in the
@@ -231,11 +302,17 @@ TEST(SurfaceFit, InvalidOptionsNameTheField) {
     o = {};
     o.max_residual_fraction = -1.0;
     EXPECT_NE(message(o).find("max_residual_fraction"), std::string::npos);
+    o = {};
+    o.degree = 4;
+    EXPECT_NE(message(o).find("degree"), std::string::npos);
     RemeshOptions r;
     r.split_fit_residual_fraction = 0.0;
     EXPECT_THROW(r.validate(), std::invalid_argument);
     r = {};
     r.smoothing_unfitted_min_angle_degrees = 61.0;
+    EXPECT_THROW(r.validate(), std::invalid_argument);
+    r = {};
+    r.smoothing_fit_degree = 1;
     EXPECT_THROW(r.validate(), std::invalid_argument);
 }
 

@@ -140,6 +140,8 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
     enum Kind : std::uint8_t { SKIPPED, BOUNDARY, CORNER, RIDGE, SMOOTH };
     std::vector<std::uint8_t> kind(n, SKIPPED);
     const double unfitted_min_angle = options.smoothing_unfitted_min_angle_degrees * M_PI / 180.0;
+    SurfaceFitOptions fit;
+    fit.degree = options.smoothing_fit_degree;
     // Each vertex reads only the current positions: independent, and the fits make it worth
     // spreading over the cores.
     tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_vertices(), VERTICES_PER_TASK),
@@ -174,7 +176,7 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
             Vec3 d = options.smoothing_step_fraction * (q.null_space_projector() * towards);
             if (options.smoothing_onto_fitted_surface && q.feature == VertexFeature::smooth) {
                 const Vec3& x = mesh.position(vi);
-                if (const std::optional<Vec3> p = fitted_vertex_point(mesh, vi, x + d)) {
+                if (const std::optional<Vec3> p = fitted_vertex_point(mesh, vi, x + d, fit)) {
                     displacement[slot] = *p - x;
                     continue;
                 }

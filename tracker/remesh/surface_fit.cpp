@@ -14,7 +14,9 @@ namespace {
 /// Design matrices whose normal matrix has an LDLT pivot below the square of this times its
 /// largest (columns are scaled to the patch radius) count as rank-deficient.
 constexpr double RANK_TOLERANCE = 1e-6;
-constexpr int COEFFICIENTS = 6;
+constexpr int QUADRATIC_COEFFICIENTS = 6;
+constexpr int CUBIC_COEFFICIENTS = 10;
+using Coefficients = Eigen::Matrix<double, CUBIC_COEFFICIENTS, 1>;
 /// arc_edge_point(): the two vertex normals may be at most 120° apart, and the arc's half angle
 /// (between the chord and each end's tangent plane) at most 60°.
 constexpr double ARC_MIN_NORMAL_COSINE = -0.5;
@@ -39,6 +41,48 @@ void append_one_ring(const SurfaceMesh& mesh, int vi, std::vector<int>& out) {
     for (int ti : mesh.vertex_triangles(vi))
         for (int w : mesh.triangle(ti))
             out.push_back(w);
+}
+
+/// Least-squares height field with N coefficients (6: quadratic, 10: cubic, in the order of
+/// the file comment) through `local` ((s, t, h) in the patch frame), in units of the patch
+/// radius: the scaled coefficients, zero-padded to 10, or nullopt where the design is
+/// rank-deficient or a vertex is further than `max_residual_fraction` of the radius from it.
+template <int N>
+std::optional<Coefficients> solve_height_field(const std::vector<Eigen::Vector3d>& local,
+                                               double radius, double max_residual_fraction) {
+    const double inv = 1.0 / radius;
+    using Row = Eigen::Matrix<double, N, 1>;
+    const auto design_row = [inv](const Eigen::Vector3d& l) {
+        const double s = l.x() * inv, t = l.y() * inv;
+        Coefficients all;
+        all << 1.0, s, t, s * s, s * t, t * t, s * s * s, s * s * t, s * t * t, t * t * t;
+        return Row(all.template head<N>());
+    };
+    // Normal equations, every column O(1) in these units. Fixed-size keeps this off the heap;
+    // it runs for every smooth vertex on every smoothing step.
+    Eigen::Matrix<double, N, N> normal_matrix = Eigen::Matrix<double, N, N>::Zero();
+    Row right = Row::Zero();
+    for (const Eigen::Vector3d& l : local) {
+        const Row row = design_row(l);
+        normal_matrix.template selfadjointView<Eigen::Lower>().rankUpdate(row);
+        right += l.z() * row;
+    }
+    normal_matrix = normal_matrix.template selfadjointView<Eigen::Lower>();
+    // Pivoted LDLT of AᵀA: its pivots bound the squared singular values of A.
+    const Eigen::LDLT<Eigen::Matrix<double, N, N>> ldlt(normal_matrix);
+    const Row pivots = ldlt.vectorD().cwiseAbs();
+    if (ldlt.info() != Eigen::Success || !(pivots.maxCoeff() > 0.0) ||
+        pivots.minCoeff() < RANK_TOLERANCE * RANK_TOLERANCE * pivots.maxCoeff())
+        return std::nullopt;
+    const Row scaled = ldlt.solve(right);
+    double residual = 0.0;
+    for (const Eigen::Vector3d& l : local)
+        residual = std::max(residual, std::abs(design_row(l).dot(scaled) - l.z()));
+    if (!(residual <= max_residual_fraction * radius))
+        return std::nullopt;
+    Coefficients padded = Coefficients::Zero();
+    padded.template head<N>() = scaled;
+    return padded;
 }
 
 }  // namespace
@@ -92,13 +136,16 @@ void SurfaceFitOptions::validate() const {
     if (!(max_residual_fraction > 0.0 && max_residual_fraction <= 1.0))
         throw std::invalid_argument("max_residual_fraction: expected a number in (0, 1], got " +
                                     std::to_string(max_residual_fraction));
+    if (degree != 2 && degree != 3)
+        throw std::invalid_argument("degree: expected 2 or 3, got " + std::to_string(degree));
 }
 
 Vec3 SurfacePatch::point_above(const Vec3& x) const {
     const Vec3 r = x - origin;
     const double s = r.dot(u), t = r.dot(v);
     const auto& c = coefficients;
-    const double h = c[0] + c[1] * s + c[2] * t + c[3] * s * s + c[4] * s * t + c[5] * t * t;
+    const double h = c[0] + c[1] * s + c[2] * t + c[3] * s * s + c[4] * s * t + c[5] * t * t +
+                     c[6] * s * s * s + c[7] * s * s * t + c[8] * s * t * t + c[9] * t * t * t;
     return origin + s * u + t * v + h * normal;
 }
 
@@ -132,7 +179,7 @@ std::optional<SurfacePatch> fit_surface_patch(const SurfaceMesh& mesh,
     for (int id : vertices)
         if (std::find(ids.begin(), ids.end(), id) == ids.end())
             ids.push_back(id);
-    if (ids.size() < static_cast<size_t>(COEFFICIENTS))
+    if (ids.size() < static_cast<size_t>(QUADRATIC_COEFFICIENTS))
         return std::nullopt;
 
     std::vector<Eigen::Vector3d> local(ids.size());
@@ -143,40 +190,20 @@ std::optional<SurfacePatch> fit_surface_patch(const SurfaceMesh& mesh,
     }
     if (!(patch.radius > 0.0))
         return std::nullopt;
-    // Normal equations of the least-squares fit, in units of the patch radius (well scaled:
-    // every column is O(1)). Fixed-size 6×6 keeps this off the heap; it runs for every smooth
-    // vertex on every smoothing step.
     const double inv = 1.0 / patch.radius;
-    using Row = Eigen::Matrix<double, COEFFICIENTS, 1>;
-    Eigen::Matrix<double, COEFFICIENTS, COEFFICIENTS> normal_matrix =
-        Eigen::Matrix<double, COEFFICIENTS, COEFFICIENTS>::Zero();
-    Row right = Row::Zero();
-    auto design_row = [inv](const Eigen::Vector3d& l) {
-        const double s = l.x() * inv, t = l.y() * inv;
-        Row row;
-        row << 1.0, s, t, s * s, s * t, t * t;
-        return row;
-    };
-    for (const Eigen::Vector3d& l : local) {
-        const Row row = design_row(l);
-        normal_matrix.selfadjointView<Eigen::Lower>().rankUpdate(row);
-        right += l.z() * row;
-    }
-    normal_matrix = normal_matrix.selfadjointView<Eigen::Lower>();
-    // Pivoted LDLT of AᵀA: its pivots bound the squared singular values of A.
-    const Eigen::LDLT<Eigen::Matrix<double, COEFFICIENTS, COEFFICIENTS>> ldlt(normal_matrix);
-    const Row pivots = ldlt.vectorD().cwiseAbs();
-    if (ldlt.info() != Eigen::Success || !(pivots.maxCoeff() > 0.0) ||
-        pivots.minCoeff() < RANK_TOLERANCE * RANK_TOLERANCE * pivots.maxCoeff())
+    std::optional<Coefficients> scaled;
+    if (options.degree == 3 && ids.size() >= static_cast<size_t>(CUBIC_COEFFICIENTS))
+        scaled = solve_height_field<CUBIC_COEFFICIENTS>(local, patch.radius, options.max_residual_fraction);
+    if (!scaled)
+        scaled =
+            solve_height_field<QUADRATIC_COEFFICIENTS>(local, patch.radius, options.max_residual_fraction);
+    if (!scaled)
         return std::nullopt;
-    const Row scaled = ldlt.solve(right);
-    double residual = 0.0;
-    for (const Eigen::Vector3d& l : local)
-        residual = std::max(residual, std::abs(design_row(l).dot(scaled) - l.z()));
-    if (!(residual <= options.max_residual_fraction * patch.radius))
-        return std::nullopt;
-    patch.coefficients << scaled[0], scaled[1] * inv, scaled[2] * inv, scaled[3] * inv * inv,
-        scaled[4] * inv * inv, scaled[5] * inv * inv;
+    // Back from units of the patch radius: a term of degree k scales by inv^k.
+    const Coefficients& f = *scaled;
+    patch.coefficients << f[0], f[1] * inv, f[2] * inv, f[3] * inv * inv, f[4] * inv * inv,
+        f[5] * inv * inv, f[6] * inv * inv * inv, f[7] * inv * inv * inv, f[8] * inv * inv * inv,
+        f[9] * inv * inv * inv;
     if (!patch.coefficients.allFinite())
         return std::nullopt;
     return patch;
