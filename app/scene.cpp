@@ -321,6 +321,10 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
               "degree of the height field smoothing_onto_fitted_surface fits over each vertex's "
               "two-ring: 3 keeps vertices drifting across a surface of varying curvature on it "
               "(A2 uses 3); 2 is a quadratic");
+    v.number("smoothing_fit_max_turn", o.smoothing_fit_max_turn, Range::non_negative(), "radians",
+             "with smoothing_onto_fitted_surface, fitted moves only where the fit turns by at most "
+             "this over its two-ring (radius × largest curvature); elsewhere, and where no fit is "
+             "found, the tangent-plane move; 0: no bound");
     v.boolean("collapse_preserves_volume", o.collapse_preserves_volume,
               "collapses lift the new vertex until the enclosed volume is kept exactly (off: it "
               "stays at the butterfly point, on the smooth surface; shrinking shapes then keep "

@@ -66,6 +66,8 @@ void RemeshOptions::validate() const {
             "RemeshOptions::smoothing_unfitted_min_angle_degrees", "must be in [0, 60]");
     require(smoothing_fit_degree == 2 || smoothing_fit_degree == 3,
             "RemeshOptions::smoothing_fit_degree", "must be 2 or 3");
+    require(std::isfinite(smoothing_fit_max_turn) && smoothing_fit_max_turn >= 0.0,
+            "RemeshOptions::smoothing_fit_max_turn", "must be finite and >= 0");
     require(std::isfinite(smoothing_step_fraction) && smoothing_step_fraction > 0.0 &&
                 smoothing_step_fraction <= 1.0,
             "RemeshOptions::smoothing_step_fraction", "must be in (0, 1]");

@@ -106,6 +106,12 @@ struct RemeshOptions {
     /// smoothing every drop vertex inside (mean −6.6e-5; on a sphere shrunk to R = 0.1 by
     /// collapses −8.7e-5). The cubic: +3.0e-5 and −6.6e-6. 2 by default (A1 was measured with it).
     int smoothing_fit_degree = 2;
+    /// With smoothing_onto_fitted_surface, fitted moves only where the fit turns by at most
+    /// this over its patch (SurfacePatch::turn(), radians, ≥ 0; 0: no bound); every other
+    /// smooth vertex — its fit refused or turning further — takes the tangent-plane move of
+    /// plain smoothing instead. A two-ring across a thin neck or a just-pinched tip (turn ≥ 1)
+    /// is too coarse for its fit to beat the plain move.
+    double smoothing_fit_max_turn = 0.0;
     /// With collision safety, a smoothing move that may collide holds the vertices of the pair
     /// still (remesh/smooth.h) instead of going through resolve_collisions, whose impulses push
     /// the neighbouring sheets apart: on A4 curl noise (thin folded sheets) that push added

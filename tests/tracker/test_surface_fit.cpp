@@ -254,6 +254,40 @@ TEST(SurfaceFit, FittedSmoothingKeepsVerticesOnTheSphere) {
     EXPECT_TRUE(is_intersection_free(fitted));
 }
 
+TEST(SurfaceFit, TurnIsPatchRadiusTimesCurvature) {
+    const SurfaceMesh mesh = sphere_mesh(0.04);
+    for (int vi = 0; vi < mesh.num_vertices(); vi += 97) {
+        const std::optional<SurfacePatch> patch = vertex_patch(mesh, vi);
+        ASSERT_TRUE(patch.has_value()) << "vertex " << vi;
+        EXPECT_NEAR(patch->turn(), patch->radius / RADIUS, 0.05 * patch->radius / RADIUS)
+            << "vertex " << vi;
+    }
+}
+
+TEST(SurfaceFit, SmoothingTakesTheTangentPlaneMoveWhereTheFitTurnsTooFar) {
+    // The sphere's two-rings turn by about 0.27 at ξ = 0.04. Below that bound every vertex
+    // smooths exactly as without the fit; above it, exactly as with it.
+    const SurfaceMesh start = sphere_mesh(0.04);
+    RemeshOptions options;
+    options.smoothing_iterations = 3;
+    ImproveContext context;
+    context.xi = 0.04;
+    auto smoothed = [&](bool fitted, double max_turn) {
+        SurfaceMesh m = start;
+        RemeshOptions o = options;
+        o.smoothing_onto_fitted_surface = fitted;
+        o.smoothing_fit_max_turn = max_turn;
+        smooth_null_space(m, o, context);
+        return m.positions();
+    };
+    const std::vector<Vec3> plane = smoothed(false, 0.0), fitted = smoothed(true, 0.0);
+    ASSERT_NE(plane, fitted);
+    EXPECT_EQ(smoothed(true, 0.1), plane);
+    EXPECT_EQ(smoothed(true, 0.5), fitted);
+    options.smoothing_fit_max_turn = -0.1;
+    EXPECT_THROW(options.validate(), std::invalid_argument);
+}
+
 TEST(SurfaceFit, SplitsOfASphereLandOnIt) {
     // α = 0.75 ξ on a ξ = 0.04 sphere: about every edge is split, most twice, so later splits see
     // the irregular stencils next to earlier ones that misled the butterfly rule.

@@ -176,14 +176,22 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
             Vec3 d = options.smoothing_step_fraction * (q.null_space_projector() * towards);
             if (options.smoothing_onto_fitted_surface && q.feature == VertexFeature::smooth) {
                 const Vec3& x = mesh.position(vi);
-                if (const std::optional<Vec3> p = fitted_vertex_point(mesh, vi, x + d, fit)) {
+                const std::optional<SurfacePatch> patch = vertex_patch(mesh, vi, fit);
+                const bool resolved = patch && (!(options.smoothing_fit_max_turn > 0.0) ||
+                                                patch->turn() <= options.smoothing_fit_max_turn);
+                const std::optional<Vec3> p =
+                    resolved ? place_on_vertex_patch(*patch, x, x + d, fit) : std::nullopt;
+                if (p) {
                     displacement[slot] = *p - x;
                     continue;
                 }
-                // No quadratic fits here (a crease or an under-resolved fillet): a tangent-plane
-                // move would leave the surface by about δ²κ/2, so move only to repair a poor
-                // triangle.
-                if (smallest_angle_around(mesh, vi) >= unfitted_min_angle)
+                // No fit here, or (with smoothing_fit_max_turn) one that turns too far over its
+                // patch to be trusted: the tangent-plane move, which with a turn bound every
+                // such vertex takes. Without one, a refused fit is a crease or an under-resolved
+                // fillet, and the tangent-plane move would leave the surface by about δ²κ/2, so
+                // it is made only to repair a poor triangle.
+                if (!(options.smoothing_fit_max_turn > 0.0) &&
+                    smallest_angle_around(mesh, vi) >= unfitted_min_angle)
                     continue;
             }
             if (options.smoothing_preserves_volume) {

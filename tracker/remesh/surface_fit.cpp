@@ -149,6 +149,12 @@ Vec3 SurfacePatch::point_above(const Vec3& x) const {
     return origin + s * u + t * v + h * normal;
 }
 
+double SurfacePatch::turn() const {
+    // Hessian [[a, b], [b, c]] of h at the origin.
+    const double a = 2.0 * coefficients[3], b = coefficients[4], c = 2.0 * coefficients[5];
+    return radius * (0.5 * std::abs(a + c) + std::hypot(0.5 * (a - c), b));
+}
+
 std::optional<SurfacePatch> fit_surface_patch(const SurfaceMesh& mesh,
                                               const std::vector<int>& vertices,
                                               const std::vector<int>& triangles,
@@ -276,8 +282,8 @@ std::optional<Vec3> arc_edge_point(const SurfaceMesh& mesh, int ei) {
     return midpoint + 0.5 * length * std::tan(0.5 * half_angle) / direction_length * direction;
 }
 
-std::optional<Vec3> fitted_vertex_point(const SurfaceMesh& mesh, int vi, const Vec3& target,
-                                        const SurfaceFitOptions& options) {
+std::optional<SurfacePatch> vertex_patch(const SurfaceMesh& mesh, int vi,
+                                         const SurfaceFitOptions& options) {
     if (mesh.vertex_triangles(vi).empty() || mesh.is_boundary_vertex(vi))
         return std::nullopt;
     // The one-ring alone (about 7 vertices) barely determines 6 coefficients: fit the two-ring.
@@ -295,17 +301,25 @@ std::optional<Vec3> fitted_vertex_point(const SurfaceMesh& mesh, int vi, const V
         normal += area_vector(mesh, ti);
     if (!(normal.norm() > 0.0))
         return std::nullopt;
-    const std::optional<SurfacePatch> patch =
-        fit_surface_patch(mesh, vertices, triangles, mesh.position(vi), normal, options);
-    if (!patch)
-        return std::nullopt;
+    return fit_surface_patch(mesh, vertices, triangles, mesh.position(vi), normal, options);
+}
+
+std::optional<Vec3> place_on_vertex_patch(const SurfacePatch& patch, const Vec3& x,
+                                          const Vec3& target, const SurfaceFitOptions& options) {
     // Shift the fitted surface through the vertex itself: its residual there (about 5e-5 above
     // a sphere of radius 0.3 at ξ = 0.04) would otherwise be added on every smoothing step.
-    const Vec3& x = mesh.position(vi);
-    const Vec3 point = patch->point_above(target) - (patch->point_above(x) - x);
-    if ((point - target).norm() > options.max_offset_fraction * patch->radius)
+    const Vec3 point = patch.point_above(target) - (patch.point_above(x) - x);
+    if ((point - target).norm() > options.max_offset_fraction * patch.radius)
         return std::nullopt;
     return point;
+}
+
+std::optional<Vec3> fitted_vertex_point(const SurfaceMesh& mesh, int vi, const Vec3& target,
+                                        const SurfaceFitOptions& options) {
+    const std::optional<SurfacePatch> patch = vertex_patch(mesh, vi, options);
+    if (!patch)
+        return std::nullopt;
+    return place_on_vertex_patch(*patch, mesh.position(vi), target, options);
 }
 
 }  // namespace meniscus::tracker

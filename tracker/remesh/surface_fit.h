@@ -63,6 +63,11 @@ struct SurfacePatch {
     Eigen::Matrix<double, 10, 1> coefficients = Eigen::Matrix<double, 10, 1>::Zero();
     /// The point of the fitted surface above (or below) x along the frame normal.
     Vec3 point_above(const Vec3& x) const;
+    /// radius times the largest |normal curvature| of the fitted surface at the origin (the
+    /// eigenvalues of the Hessian of h there): about the angle, in radians, the surface turns
+    /// over the patch. Near 0 on a well-resolved patch; a two-ring across a pinched tip or a
+    /// thin neck turns by 1 or more.
+    double turn() const;
 };
 
 /// Fits `vertices` (live vertex ids; duplicates are ignored) over the frame with origin `origin`
@@ -111,5 +116,16 @@ std::optional<Vec3> arc_edge_point(const SurfaceMesh& mesh, int ei);
 /// `target` further than max_offset_fraction of the patch radius.
 std::optional<Vec3> fitted_vertex_point(const SurfaceMesh& mesh, int vi, const Vec3& target,
                                         const SurfaceFitOptions& options = {});
+
+/// The fit fitted_vertex_point() places points on: over live vertex `vi`'s two-ring, in the
+/// frame of its area-weighted normal with the origin at the vertex. nullopt where it does.
+std::optional<SurfacePatch> vertex_patch(const SurfaceMesh& mesh, int vi,
+                                         const SurfaceFitOptions& options = {});
+
+/// fitted_vertex_point() on a patch from vertex_patch(): where a vertex at `x` moved to
+/// `target` lands, nullopt where it moves further than max_offset_fraction of the patch radius.
+std::optional<Vec3> place_on_vertex_patch(const SurfacePatch& patch, const Vec3& x,
+                                          const Vec3& target,
+                                          const SurfaceFitOptions& options = {});
 
 }  // namespace meniscus::tracker
