@@ -157,8 +157,8 @@ double SurfacePatch::turn() const {
 
 std::optional<SurfacePatch> fit_surface_patch(const SurfaceMesh& mesh,
                                               const std::vector<int>& vertices,
-                                              const std::vector<int>& triangles,
-                                              const Vec3& origin, const Vec3& normal,
+                                              const std::vector<int>& triangles, const Vec3& origin,
+                                              const Vec3& normal,
                                               const SurfaceFitOptions& options) {
     options.validate();
     const double normal_length = normal.norm();
@@ -199,10 +199,11 @@ std::optional<SurfacePatch> fit_surface_patch(const SurfaceMesh& mesh,
     const double inv = 1.0 / patch.radius;
     std::optional<Coefficients> scaled;
     if (options.degree == 3 && ids.size() >= static_cast<size_t>(CUBIC_COEFFICIENTS))
-        scaled = solve_height_field<CUBIC_COEFFICIENTS>(local, patch.radius, options.max_residual_fraction);
+        scaled = solve_height_field<CUBIC_COEFFICIENTS>(local, patch.radius,
+                                                        options.max_residual_fraction);
     if (!scaled)
-        scaled =
-            solve_height_field<QUADRATIC_COEFFICIENTS>(local, patch.radius, options.max_residual_fraction);
+        scaled = solve_height_field<QUADRATIC_COEFFICIENTS>(local, patch.radius,
+                                                            options.max_residual_fraction);
     if (!scaled)
         return std::nullopt;
     // Back from units of the patch radius: a term of degree k scales by inv^k.

@@ -14,8 +14,8 @@
 ///
 /// The fit is refused where the patch is not a graph over the frame (a triangle normal more
 /// than `max_normal_angle_degrees` from n), is too small or degenerate (fewer than 6 vertices, or
-/// a rank-deficient design matrix), is not a quadratic (or cubic) (a residual above `max_residual_fraction`
-/// of the patch size), or where the fitted point moves further than
+/// a rank-deficient design matrix), does not fit (a residual above `max_residual_fraction` of the
+/// patch size), or where the fitted point moves further than
 /// `max_offset_fraction` of the patch's size from the point it replaces: features (creases,
 /// corners) are left to the callers' sharp rules.
 
@@ -44,12 +44,13 @@ struct SurfaceFitOptions {
     double max_residual_fraction = 1e-2;
     /// Degree of the height field, 2 or 3. A quadratic fitted to a surface whose curvature
     /// varies takes the cubic part into its slope: over a stencil of radius ρ the slope at the
-    /// centre is off by about ρ²·h‴/2 along the direction the curvature grows in, even for a
-    /// symmetric stencil. A point moved by d along the fit then leaves the surface by that slope
-    /// error times d, an error first order in d that does not average out when vertices keep
-    /// drifting the same way (the A2 dumbbell at ξ = 0.02 drifted 2.2e-4 outward with fitted
-    /// smoothing). The cubic moves that error to the quartic part. It needs 10 vertices; a
-    /// patch with fewer, or a rank-deficient cubic design, falls back to the quadratic.
+    /// centre is off by a stencil-dependent fraction of ρ²·h‴ (about a tenth on a regular
+    /// two-ring), along the direction the curvature grows in, even for a symmetric stencil. A point
+    /// moved by d along the fit then leaves the surface by that slope error times d, an error first
+    /// order in d that does not average out when vertices keep drifting the same way (the A2
+    /// dumbbell at ξ = 0.02 drifted 2.2e-4 outward with fitted smoothing). The cubic moves that
+    /// error to the quartic part. It needs 10 vertices; a patch with fewer, or a rank-deficient
+    /// cubic design, falls back to the quadratic.
     int degree = 2;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
@@ -76,8 +77,8 @@ struct SurfacePatch {
 /// (see the file comment). Throws std::invalid_argument on invalid options or a zero normal.
 std::optional<SurfacePatch> fit_surface_patch(const SurfaceMesh& mesh,
                                               const std::vector<int>& vertices,
-                                              const std::vector<int>& triangles,
-                                              const Vec3& origin, const Vec3& normal,
+                                              const std::vector<int>& triangles, const Vec3& origin,
+                                              const Vec3& normal,
                                               const SurfaceFitOptions& options = {});
 
 /// Point on the smooth surface above the midpoint of live edge `ei`: the fit over the vertices
