@@ -187,6 +187,44 @@ TEST(FlowScenes, SphereUnderMeanCurvatureRecordsTheExactRadius) {
     fs::remove_all(options.out_dir);
 }
 
+/// Mean signed vertex distance to the exact sphere of the last frame of the A2 sphere scene at
+/// ξ = 0.02 run to t_end, with tangent-plane smoothing or smoothing along a cubic fitted over
+/// each two-ring where it turns by at most 0.6 rad.
+double shrunk_sphere_mean_error(double t_end, bool fitted_smoothing) {
+    Scene scene = load_scene(FLOW_SCENES + "a2_sphere_xi0.02.json");
+    scene.tracker.verify_intersection_free = false;
+    scene.tracker.remesh.smoothing_onto_fitted_surface = fitted_smoothing;
+    scene.tracker.remesh.smoothing_fit_degree = 3;
+    scene.tracker.remesh.smoothing_fit_max_turn = 0.6;
+    scene.time.end = t_end;
+    scene.time.frames = 1;
+    RunOptions options;
+    options.out_dir = (fs::temp_directory_path() / "meniscus_a2_shrunk").string();
+    options.quiet = true;
+    const std::atomic<bool> stop{false};
+    run_scene(scene, options, stop);
+    const tracker::SurfaceMesh mesh = tracker::to_surface_mesh(
+        tracker::read_mesh_file((fs::path(options.out_dir) / "surface_0001.ply").string()), "ply");
+    fs::remove_all(options.out_dir);
+    return tracker::sphere_error(mesh, Eigen::Vector3d::Zero(), std::sqrt(0.09 - 4.0 * t_end))
+        .vertex_mean_signed;
+}
+
+TEST(FlowScenes, ShrinkingSphereDoesNotSinkUnderFittedSmoothing) {
+    // Issue #5: R = 0.3 → 0.1 at ξ = 0.02, a mesh collapsing from 14 800 to 1 900 triangles.
+    // Tangent-plane smoothing of the irregular rings the collapses leave sinks every vertex
+    // inside the exact sphere (the A2 dumbbell's drops at ξ = 0.01 likewise, by 2.3e-5, above
+    // the paper's error); smoothing along a cubic fitted over each two-ring does not. (The
+    // drops' two-rings turn by about 0.4 here, under the bound.) Measured mean signed vertex
+    // error: tangent plane −8.66e-5, fitted −6.6e-6.
+    const double fitted = shrunk_sphere_mean_error(0.02, true);
+    const double plane = shrunk_sphere_mean_error(0.02, false);
+    std::cout << "[ measured ] A2 sphere 0.3 → 0.1, ξ = 0.02: mean signed vertex error, fitted "
+              << fitted << ", tangent plane " << plane << "\n";
+    EXPECT_LT(plane, -5e-5);
+    EXPECT_LT(std::abs(fitted), 0.25 * std::abs(plane));
+}
+
 TEST(FlowScenes, OpenSheetKeepsItsBoundaryUnderCurlNoise) {
     Scene scene = load_scene(FLOW_SCENES + "a4_curl_noise_open_xi0.04.json");
     RunOptions options;
