@@ -314,13 +314,14 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
     v.boolean("split_on_fitted_surface", o.split_on_fitted_surface,
               "put split vertices on a fitted quadratic surface or circular arc instead of the "
               "butterfly point (more accurate shape; gains volume on the Enright test)");
-    v.boolean("smoothing_onto_fitted_surface", o.smoothing_onto_fitted_surface,
-              "smoothing moves smooth vertices along a fitted quadratic surface instead of "
-              "volume-neutrally in the tangent plane (more accurate shape; not volume-neutral)");
+    v.boolean(
+        "smoothing_onto_fitted_surface", o.smoothing_onto_fitted_surface,
+        "smoothing moves smooth vertices along a fitted surface (smoothing_fit_degree) instead of "
+        "volume-neutrally in the tangent plane (more accurate shape; not volume-neutral)");
     v.integer("smoothing_fit_degree", o.smoothing_fit_degree, Range::between(2, 3), "",
               "degree of the height field smoothing_onto_fitted_surface fits over each vertex's "
-              "two-ring: 3 keeps vertices drifting across a surface of varying curvature on it "
-              "(A2 uses 3); 2 is a quadratic");
+              "two-ring: 3 keeps vertices drifting across a surface of varying curvature on it; "
+              "2 is a quadratic");
     v.number("smoothing_fit_max_turn", o.smoothing_fit_max_turn, Range::non_negative(), "radians",
              "with smoothing_onto_fitted_surface, fitted moves only where the fit turns by at most "
              "this over its two-ring (radius × largest curvature); elsewhere, and where no fit is "

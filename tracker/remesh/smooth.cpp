@@ -142,6 +142,7 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
     const double unfitted_min_angle = options.smoothing_unfitted_min_angle_degrees * M_PI / 180.0;
     SurfaceFitOptions fit;
     fit.degree = options.smoothing_fit_degree;
+    const bool turn_bounded = options.smoothing_fit_max_turn > 0.0;
     // Each vertex reads only the current positions: independent, and the fits make it worth
     // spreading over the cores.
     tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_vertices(), VERTICES_PER_TASK),
@@ -177,8 +178,8 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
             if (options.smoothing_onto_fitted_surface && q.feature == VertexFeature::smooth) {
                 const Vec3& x = mesh.position(vi);
                 const std::optional<SurfacePatch> patch = vertex_patch(mesh, vi, fit);
-                const bool resolved = patch && (!(options.smoothing_fit_max_turn > 0.0) ||
-                                                patch->turn() <= options.smoothing_fit_max_turn);
+                const bool resolved =
+                    patch && (!turn_bounded || patch->turn() <= options.smoothing_fit_max_turn);
                 const std::optional<Vec3> p =
                     resolved ? place_on_vertex_patch(*patch, x, x + d, fit) : std::nullopt;
                 if (p) {
@@ -190,8 +191,7 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
                 // such vertex takes. Without one, a refused fit is a crease or an under-resolved
                 // fillet, and the tangent-plane move would leave the surface by about δ²κ/2, so
                 // it is made only to repair a poor triangle.
-                if (!(options.smoothing_fit_max_turn > 0.0) &&
-                    smallest_angle_around(mesh, vi) >= unfitted_min_angle)
+                if (!turn_bounded && smallest_angle_around(mesh, vi) >= unfitted_min_angle)
                     continue;
             }
             if (options.smoothing_preserves_volume) {
