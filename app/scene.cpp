@@ -314,6 +314,10 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
     v.boolean("split_on_fitted_surface", o.split_on_fitted_surface,
               "put split vertices on a fitted quadratic surface or circular arc instead of the "
               "butterfly point (more accurate shape; gains volume on the Enright test)");
+    v.boolean("collapse_on_fitted_surface", o.collapse_on_fitted_surface,
+              "collapses aim the merged vertex at the fitted-surface or circular-arc point a "
+              "split of the edge would use instead of the butterfly point (shrinking shapes keep "
+              "their vertices on the surface)");
     v.boolean(
         "smoothing_onto_fitted_surface", o.smoothing_onto_fitted_surface,
         "smoothing moves smooth vertices along a fitted surface (smoothing_fit_degree) instead of "

@@ -126,6 +126,9 @@ TEST(Scene, GeometricFlowErrorsNameTheJsonPath) {
     EXPECT_NE(error_with(R"("tracker": {"remesh": {"collapse_preserves_volume": 1}})")
                   .find("/tracker/remesh/collapse_preserves_volume: expected"),
               std::string::npos);
+    EXPECT_NE(error_with(R"("tracker": {"remesh": {"collapse_on_fitted_surface": "yes"}})")
+                  .find("/tracker/remesh/collapse_on_fitted_surface: expected"),
+              std::string::npos);
     EXPECT_NE(error_with(R"("tracker": {"remesh": {"smoothing_fit_degree": 4}})")
                   .find("/tracker/remesh/smoothing_fit_degree: expected an integer in [2, 3]"),
               std::string::npos);

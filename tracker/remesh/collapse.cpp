@@ -4,6 +4,7 @@
 #include "tracker/remesh/butterfly.h"
 #include "tracker/remesh/local_safety.h"
 #include "tracker/remesh/sizing.h"
+#include "tracker/remesh/surface_fit.h"
 
 #include <algorithm>
 #include <chrono>
@@ -89,6 +90,9 @@ CollapsePlan volume_preserving(const SurfaceMesh& mesh, CollapsePlan plan) {
 struct PlanCandidates {
     std::vector<CollapsePlan> plans;
     bool feature_kept = false;
+    /// The rule that placed the preferred position on the smooth surface
+    /// (RemeshOptions::collapse_on_fitted_surface); empty for the butterfly or midpoint.
+    std::optional<EdgePointRule> on_surface;
 };
 
 PlanCandidates plan_collapse(const SurfaceMesh& mesh, int ei, const RemeshOptions& options) {
@@ -133,7 +137,18 @@ PlanCandidates plan_collapse(const SurfaceMesh& mesh, int ei, const RemeshOption
     }
     Vec3 preferred;
     if (q0.feature == VertexFeature::smooth) {
-        preferred = butterfly_point(mesh, ei).value_or(edge_midpoint(mesh, ei));
+        std::optional<SurfaceEdgePoint> on_surface;
+        if (options.collapse_on_fitted_surface) {
+            SurfaceFitOptions fit;
+            fit.max_residual_fraction = options.split_fit_residual_fraction;
+            on_surface = surface_edge_point(mesh, ei, thresholds, fit);
+        }
+        if (on_surface) {
+            preferred = on_surface->point;
+            out.on_surface = on_surface->rule;
+        } else {
+            preferred = butterfly_point(mesh, ei).value_or(edge_midpoint(mesh, ei));
+        }
     } else {
         // Both on a ridge: the butterfly stencil reaches across the feature and would round it
         // off; the midpoint stays on a straight ridge.
@@ -411,6 +426,8 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
             ++collapses_this_pass;
             report.retries_towards_midpoint += chosen > 0 ? 1 : 0;
             report.feature_vertex_kept += candidates.feature_kept && chosen == 0 ? 1 : 0;
+            if (candidates.on_surface && chosen == 0)
+                ++(*candidates.on_surface == EdgePointRule::fitted ? report.fitted : report.arc);
         }
         if (collapses_this_pass == 0)
             break;

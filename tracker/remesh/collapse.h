@@ -1,12 +1,13 @@
 #pragma once
 /// \file Edge collapse (paper §3.5.3): edges shorter than β are replaced by one vertex. The new
-/// position is the butterfly point, except that a vertex on a ridge or corner (quadric metric
-/// tensor, quadric.h) keeps its place when the other end is less of a feature (of two corners,
-/// the sharper one), and an edge between two ridge vertices collapses to its midpoint (the
-/// butterfly stencil would reach across the feature and round it off). With
-/// RemeshOptions::collapse_preserves_volume (default) that position then moves along the
-/// gradient of the enclosed volume (the area-weighted normal of the new star, so a kept ridge
-/// vertex moves across its ridge, not along it; a kept corner does not move) until the
+/// position is the butterfly point (with RemeshOptions::collapse_on_fitted_surface, the
+/// fitted-surface or circular-arc point of remesh/surface_fit.h where those exist), except that a
+/// vertex on a ridge or corner (quadric metric tensor, quadric.h) keeps its place when the other
+/// end is less of a feature (of two corners, the sharper one), and an edge between two ridge
+/// vertices collapses to its midpoint (the butterfly stencil would reach across the feature and
+/// round it off). With RemeshOptions::collapse_preserves_volume (default) that position then moves
+/// along the gradient of the enclosed volume (the area-weighted normal of the new star, so a kept
+/// ridge vertex moves across its ridge, not along it; a kept corner does not move) until the
 /// collapse keeps the volume exactly: the coarser star otherwise cuts inside a convex
 /// surface. Both endpoints
 /// move there as a pseudo-motion checked by CCD; if it may collide, positions closer to the
@@ -36,6 +37,9 @@ struct CollapseReport {
     int refused_collision = 0;    ///< no collision-free trajectory found
     int retries_towards_midpoint = 0;  ///< collapses that succeeded on a later trajectory
     int feature_vertex_kept = 0;       ///< collapses into a ridge/corner vertex's position
+    /// Collapses to a fitted-surface or circular-arc point (collapse_on_fitted_surface).
+    int fitted = 0;
+    int arc = 0;
     int refused_total() const {
         return refused_topology + refused_normal + refused_volume + refused_long_edge +
                refused_collision;

@@ -6,7 +6,6 @@
 #include "tracker/remesh/sizing.h"
 #include "tracker/remesh/smooth.h"
 #include "tracker/remesh/surface_fit.h"
-#include "tracker/quadric.h"
 
 #include <algorithm>
 #include <chrono>
@@ -116,16 +115,11 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
             }
             // Where the new vertex goes (named for the paper's rule, which is the last resort).
             std::optional<Vec3> butterfly;
-            if (options.split_on_fitted_surface) {
-                if (vertex_quadric(mesh, e[0], thresholds).feature == VertexFeature::smooth &&
-                    vertex_quadric(mesh, e[1], thresholds).feature == VertexFeature::smooth)
-                    butterfly = fitted_edge_point(mesh, ei, fit);
-                if (butterfly) {
-                    ++report.fitted;
-                } else if ((butterfly = arc_edge_point(mesh, ei))) {
-                    ++report.arc;
+            if (options.split_on_fitted_surface)
+                if (const auto on_surface = surface_edge_point(mesh, ei, thresholds, fit)) {
+                    butterfly = on_surface->point;
+                    ++(on_surface->rule == EdgePointRule::fitted ? report.fitted : report.arc);
                 }
-            }
             if (!butterfly)
                 butterfly = butterfly_point(mesh, ei);
             const Vec3 midpoint = edge_midpoint(mesh, ei);

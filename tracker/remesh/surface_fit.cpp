@@ -283,6 +283,19 @@ std::optional<Vec3> arc_edge_point(const SurfaceMesh& mesh, int ei) {
     return midpoint + 0.5 * length * std::tan(0.5 * half_angle) / direction_length * direction;
 }
 
+std::optional<SurfaceEdgePoint> surface_edge_point(const SurfaceMesh& mesh, int ei,
+                                                   const FeatureThresholds& thresholds,
+                                                   const SurfaceFitOptions& options) {
+    const Edge& e = mesh.edge(ei);
+    if (vertex_quadric(mesh, e[0], thresholds).feature == VertexFeature::smooth &&
+        vertex_quadric(mesh, e[1], thresholds).feature == VertexFeature::smooth)
+        if (const std::optional<Vec3> p = fitted_edge_point(mesh, ei, options))
+            return SurfaceEdgePoint{*p, EdgePointRule::fitted};
+    if (const std::optional<Vec3> p = arc_edge_point(mesh, ei))
+        return SurfaceEdgePoint{*p, EdgePointRule::arc};
+    return std::nullopt;
+}
+
 std::optional<SurfacePatch> vertex_patch(const SurfaceMesh& mesh, int vi,
                                          const SurfaceFitOptions& options) {
     if (mesh.vertex_triangles(vi).empty() || mesh.is_boundary_vertex(vi))

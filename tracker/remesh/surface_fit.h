@@ -20,6 +20,7 @@
 /// corners) are left to the callers' sharp rules.
 
 #include "tracker/mesh.h"
+#include "tracker/quadric.h"
 
 #include <Eigen/Core>
 
@@ -108,6 +109,26 @@ std::optional<Vec3> majority_normal(const SurfaceMesh& mesh, int vi,
 /// midpoint, midpoint − (w₀n₀ + w₁n₁)/8. nullopt for boundary and non-manifold edges, normals
 /// more than 120° apart, or θ/2 above 60°.
 std::optional<Vec3> arc_edge_point(const SurfaceMesh& mesh, int ei);
+
+/// Which rule placed a surface_edge_point().
+enum class EdgePointRule {
+    fitted,  ///< fitted_edge_point()
+    arc,     ///< arc_edge_point()
+};
+
+/// A point on the smooth surface near the middle of an edge, and the rule that placed it.
+struct SurfaceEdgePoint {
+    Vec3 point = Vec3::Zero();
+    EdgePointRule rule = EdgePointRule::fitted;
+};
+
+/// Where a vertex replacing live edge `ei` (a split's new vertex, a collapse's merged one) goes
+/// on the smooth surface: fitted_edge_point() where both endpoints are smooth (quadric rank 1
+/// under `thresholds`) and the fit is accepted, else arc_edge_point(). nullopt where neither
+/// applies (callers fall back to the butterfly point).
+std::optional<SurfaceEdgePoint> surface_edge_point(const SurfaceMesh& mesh, int ei,
+                                                   const FeatureThresholds& thresholds,
+                                                   const SurfaceFitOptions& options = {});
 
 /// Where live vertex `vi` moved to `target` lands on the smooth surface fitted over its two-ring
 /// (the vertex's own current position included), in the frame of its area-weighted normal,
