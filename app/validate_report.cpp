@@ -3,14 +3,13 @@
 
 #include "app/validate_report.h"
 
+#include "app/plot_script.h"
 #include "app/validate_parameters.h"
 #include "tracker/flows/curl_noise.h"
 #include "tracker/remesh_options.h"
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -491,22 +490,11 @@ for case in ("A1", "A2", "A3", "A4"):
     series_plot(case, "triangles", c + "_triangles.png", "triangles")
 )PY";
 
-/// Python with matplotlib (Debian's python3-matplotlib).
-constexpr const char* PYTHON = "/usr/bin/python3";
-
 /// Writes plot_validation.py into the folder and runs it; returns a note for the report.
 std::string make_plots(const std::filesystem::path& out) {
-    const std::filesystem::path script = out / "plot_validation.py";
-    {
-        std::ofstream f(script);
-        f << PLOT_SCRIPT;
-    }
-    const std::string command = std::string(PYTHON) + " '" + script.string() + "' '" +
-                                out.string() + "' 2> '" + (out / "plot_errors.txt").string() + "'";
-    if (std::system(command.c_str()) != 0)
-        return "**Plots failed** (`" + std::string(PYTHON) +
+    if (!run_plot_script(out, "plot_validation.py", PLOT_SCRIPT, "plot_errors.txt"))
+        return "**Plots failed** (`" + std::string(PLOT_PYTHON) +
                "` with matplotlib is needed; see plot_errors.txt): the report has no PNGs.";
-    std::filesystem::remove(out / "plot_errors.txt");
     return "Plots (PNG, made by `plot_validation.py` from results.json): a1_error.png, "
            "aN_volume.png, aN_triangles.png for each case run.";
 }
