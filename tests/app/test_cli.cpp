@@ -109,6 +109,14 @@ TEST_F(CliTest, ValidateXiThatNoSelectedCaseRunsIsBadInput) {
     EXPECT_FALSE(fs::exists(m_dir / "v" / "report.md"));
 }
 
+TEST_F(CliTest, ValidateUnknownCaseIsBadInput) {
+    const Outcome o = run_meniscus("validate --case A9 --out " + (m_dir / "v").string());
+    EXPECT_EQ(o.exit_code, 2);
+    EXPECT_NE(o.output.find("unknown case 'A9' (expected A1, A2, A3, A4 or B1"), std::string::npos)
+        << o.output;
+    EXPECT_FALSE(fs::exists(m_dir / "v" / "report.md"));
+}
+
 TEST_F(CliTest, ValidateBadXiValueIsBadInput) {
     for (const char* value : {"fine", "-0.01", "0", "0.01m"}) {
         const Outcome o = run_meniscus(std::string("validate --xi ") + value);
