@@ -291,6 +291,11 @@ std::vector<double> a2_dumbbell_xis(bool full) {
     return full ? std::vector<double>(std::begin(A2_FULL_XI), std::end(A2_FULL_XI))
                 : std::vector<double>(std::begin(A2_QUICK_XI), std::end(A2_QUICK_XI));
 }
+std::vector<double> a2_spheroid_xis(bool full) {
+    return full ? std::vector<double>(std::begin(A2_SPHEROID_FULL_XI), std::end(A2_SPHEROID_FULL_XI))
+                : std::vector<double>(std::begin(A2_SPHEROID_QUICK_XI),
+                                      std::end(A2_SPHEROID_QUICK_XI));
+}
 std::vector<double> a3_xis(bool full) {
     return full ? std::vector<double>{0.02, 0.01} : std::vector<double>{0.02};
 }
@@ -301,6 +306,8 @@ std::vector<double> case_xis(const std::string& id, bool full) {
         xis.push_back(A1_UNSAFE_XI);
     } else if (id == "A2") {
         xis = a2_sphere_xis(full);
+        for (double xi : a2_spheroid_xis(full))
+            xis.push_back(xi);
         for (double xi : a2_dumbbell_xis(full))
             xis.push_back(xi);
     } else if (id == "A3") {
@@ -441,6 +448,50 @@ void case_a2(Context& c) {
             j["initial_radius"] = MCF_SPHERE_RADIUS;
             j["exact_radius"] = exact;
             j["error"] = error_json(tracker::sphere_error(r.final_mesh, center, exact));
+            c.add(std::move(j), r);
+        }
+    }
+    // Meyer's operator alone: the spheroid with every remeshing operation off, against its own
+    // axisymmetric reference (coarse and fine grid).
+    {
+        const tracker::ShapePtr spheroid = tracker::make_ellipsoid(
+            Vec3::Zero(),
+            Vec3(MCF_SPHEROID_RADII[0], MCF_SPHEROID_RADII[1], MCF_SPHEROID_RADII[2]));
+        std::vector<double> xis;
+        for (double xi : a2_spheroid_xis(c.full))
+            if (c.runs_xi(xi))
+                xis.push_back(xi);
+        const double* dx = c.full ? A2_SPHEROID_DX_FULL : A2_SPHEROID_DX_QUICK;
+        std::vector<tracker::AxisymmetricMcfReference> refs;
+        for (int i = 0; i < 2 && !xis.empty(); ++i) {
+            tracker::AxisymmetricMcfOptions o;
+            o.voxel_size = dx[i];
+            o.end_time = MCF_SPHEROID_END;
+            refs.emplace_back(*spheroid, Vec3::Zero(), Vec3::UnitX(), o);
+        }
+        tracker::TrackerOptions fixed = mcf_tracker;
+        fixed.remesh.split = fixed.remesh.flip = fixed.remesh.collapse = fixed.remesh.smooth =
+            false;
+        for (double xi : xis) {
+            RunSpec s;
+            s.case_id = "A2";
+            s.label = "spheroid, no remeshing";
+            s.xi_requested = xi;
+            s.shape = spheroid;
+            s.tracker = fixed;
+            s.stepper = stepper;
+            s.t_end = MCF_SPHEROID_END;
+            s.max_dt = MCF_MAX_DT;
+            const RunResult r = run_tracked(s, c.quiet);
+            Json j = run_json(r);
+            const auto phi = [&](const tracker::AxisymmetricMcfReference& ref) {
+                return [&ref](const Vec3& x) { return ref.distance(x); };
+            };
+            j["error"] = error_json(tracker::surface_error(r.final_mesh, phi(refs[1])));
+            j["reference_difference"] = error_json(tracker::surface_error(
+                r.final_mesh,
+                [&](const Vec3& x) { return refs[0].distance(x) - refs[1].distance(x); }));
+            j["reference_voxel_size"] = dx[1];
             c.add(std::move(j), r);
         }
     }

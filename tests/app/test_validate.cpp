@@ -62,6 +62,12 @@ constexpr double A2_QUICK_REFERENCE_MAX_DIFFERENCE_BOUND = 5e-4;
 /// points, so neither bound is tight.
 constexpr double A2_QUICK_OPENVDB_L1_BOUND = 8e-3;
 constexpr double A2_QUICK_OPENVDB_REFERENCE_DIFFERENCE_BOUND = 1.2e-2;
+/// A2 operator floor: the spheroid (0.3, 0.2, 0.2) with no remeshing at ξ = 0.04 to t = 0.006.
+/// Meyer's operator lags at the poles (x = ±0.3 at the start): vertex L∞ measured 3.02e-4,
+/// positive, at |x| = 0.2; the reference grids differ by 7e-6 there, so the error is the
+/// mesh's.
+constexpr double A2_SPHEROID_VERTEX_LINF_BOUND = 5e-4;
+constexpr double A2_SPHEROID_POLE_X = 0.15;
 /// Enright quick variant (period 1, ξ = 0.02): relative volume change bound, percent.
 constexpr double ENRIGHT_QUICK_VOLUME_PERCENT = 0.5;
 /// Enright quick: the surface returns near the initial sphere (L∞ distance, m; ξ = 0.02).
@@ -164,6 +170,21 @@ TEST_F(QuickValidation, SphereMeanCurvatureFollowsExactRadius) {
     ASSERT_EQ(s.size(), 1u);
     const double r = s[0]["exact_radius"].get<double>();
     EXPECT_LT(s[0]["error"]["vertex_linf"].get<double>(), MCF_RELATIVE_VERTEX_ERROR * r);
+}
+
+TEST_F(QuickValidation, MeyerOperatorAloneLagsAtTheSpheroidPoles) {
+    const std::vector<Json> s = runs("A2", "spheroid, no remeshing");
+    ASSERT_EQ(s.size(), 1u);
+    const Json& e = s[0]["error"];
+    std::cout << "[ measured ] A2 spheroid ξ=0.04, no remeshing: vertex L∞ " << e["vertex_linf"]
+              << " at x = " << e["vertex_linf_position"][0] << ", signed max "
+              << e["vertex_max_signed"] << "; reference grids differ by "
+              << s[0]["reference_difference"]["vertex_linf"] << "\n";
+    EXPECT_LT(e["vertex_linf"].get<double>(), A2_SPHEROID_VERTEX_LINF_BOUND);
+    EXPECT_EQ(e["vertex_max_signed"].get<double>(), e["vertex_linf"].get<double>());  // a lag
+    EXPECT_GT(std::abs(e["vertex_linf_position"][0].get<double>()), A2_SPHEROID_POLE_X);
+    EXPECT_GT(e["vertex_linf"].get<double>(),
+              10.0 * s[0]["reference_difference"]["vertex_linf"].get<double>());
 }
 
 TEST_F(QuickValidation, DumbbellPinchesOffNearTheLevelSetReference) {
