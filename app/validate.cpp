@@ -188,6 +188,16 @@ void case_a1(Context& c) {
     c.add(run_json(r), r);
 }
 
+/// φ(x) of a reference solution (anything with distance(x)), and the difference of two.
+template <typename Reference>
+auto distance_of(const Reference& ref) {
+    return [&ref](const Vec3& x) { return ref.distance(x); };
+}
+template <typename Reference>
+auto difference_of(const Reference& coarse, const Reference& fine) {
+    return [&coarse, &fine](const Vec3& x) { return coarse.distance(x) - fine.distance(x); };
+}
+
 void case_a2(Context& c) {
     tracker::MeanCurvatureFlowOptions mcf;
     if (MCF_HEUN)
@@ -197,22 +207,27 @@ void case_a2(Context& c) {
     mcf_tracker.remesh.collapse_preserves_volume = MCF_COLLAPSE_PRESERVES_VOLUME;
     mcf_tracker.remesh.curvature_edge_fraction = MCF_CURVATURE_EDGE_FRACTION;
     mcf_tracker.remesh.split_on_fitted_surface = MCF_CURVATURE_EDGE_FRACTION > 0.0;
+    const auto mcf_run = [&](const char* label, double xi, tracker::ShapePtr shape,
+                             const tracker::TrackerOptions& tracker, double t_end) {
+        RunSpec s;
+        s.case_id = "A2";
+        s.label = label;
+        s.xi_requested = xi;
+        s.shape = std::move(shape);
+        s.tracker = tracker;
+        s.stepper = stepper;
+        s.t_end = t_end;
+        s.max_dt = MCF_MAX_DT;
+        return run_tracked(s, c.quiet);
+    };
     {
         const Vec3 center = Vec3::Zero();
         const double t_end = MCF_SPHERE_TIME_FRACTION * MCF_SPHERE_RADIUS * MCF_SPHERE_RADIUS / 4.0;
         for (double xi : a2_sphere_xis(c.full)) {
             if (!c.runs_xi(xi))
                 continue;
-            RunSpec s;
-            s.case_id = "A2";
-            s.label = "sphere";
-            s.xi_requested = xi;
-            s.shape = tracker::make_sphere(center, MCF_SPHERE_RADIUS);
-            s.tracker = mcf_tracker;
-            s.stepper = stepper;
-            s.t_end = t_end;
-            s.max_dt = MCF_MAX_DT;
-            const RunResult r = run_tracked(s, c.quiet);
+            const RunResult r = mcf_run(
+                "sphere", xi, tracker::make_sphere(center, MCF_SPHERE_RADIUS), mcf_tracker, t_end);
             Json j = run_json(r);
             const double exact = tracker::sphere_mean_curvature_radius(MCF_SPHERE_RADIUS, r.t);
             j["initial_radius"] = MCF_SPHERE_RADIUS;
@@ -243,25 +258,12 @@ void case_a2(Context& c) {
         fixed.remesh.split = fixed.remesh.flip = fixed.remesh.collapse = fixed.remesh.smooth =
             false;
         for (double xi : xis) {
-            RunSpec s;
-            s.case_id = "A2";
-            s.label = "spheroid, no remeshing";
-            s.xi_requested = xi;
-            s.shape = spheroid;
-            s.tracker = fixed;
-            s.stepper = stepper;
-            s.t_end = MCF_SPHEROID_END;
-            s.max_dt = MCF_MAX_DT;
-            const RunResult r = run_tracked(s, c.quiet);
+            const RunResult r =
+                mcf_run("spheroid, no remeshing", xi, spheroid, fixed, MCF_SPHEROID_END);
             Json j = run_json(r);
-            const auto phi = [&](const tracker::AxisymmetricMcfReference& ref) {
-                return [&ref](const Vec3& x) { return ref.distance(x); };
-            };
-            j["error"] = error_json(tracker::surface_error(r.final_mesh, phi(refs[1])));
+            j["error"] = error_json(tracker::surface_error(r.final_mesh, distance_of(refs[1])));
             j["reference_difference"] =
-                error_json(tracker::surface_error(r.final_mesh, [&](const Vec3& x) {
-                    return refs[0].distance(x) - refs[1].distance(x);
-                }));
+                error_json(tracker::surface_error(r.final_mesh, difference_of(refs[0], refs[1])));
             j["reference_voxel_size"] = dx[1];
             c.add(std::move(j), r);
         }
@@ -333,25 +335,9 @@ void case_a2(Context& c) {
         return refs;
     });
     std::vector<RunResult> runs;
-    for (double xi : dumbbell_xis) {
-        RunSpec s;
-        s.case_id = "A2";
-        s.label = "dumbbell";
-        s.xi_requested = xi;
-        s.shape = dumbbell;
-        s.tracker = mcf_tracker;
-        s.stepper = stepper;
-        s.t_end = DUMBBELL_END;
-        s.max_dt = MCF_MAX_DT;
-        runs.push_back(run_tracked(s, c.quiet));
-    }
+    for (double xi : dumbbell_xis)
+        runs.push_back(mcf_run("dumbbell", xi, dumbbell, mcf_tracker, DUMBBELL_END));
     const References refs = pending.get();
-    const auto phi_of = [](const auto& ref) {
-        return [&ref](const Vec3& x) { return ref.distance(x); };
-    };
-    const auto difference_of = [](const auto& coarse, const auto& fine) {
-        return [&coarse, &fine](const Vec3& x) { return coarse.distance(x) - fine.distance(x); };
-    };
     const double axi_trusted =
         refs.axis.back().band_half_width() - A2_AXISYMMETRIC_TRUSTED_MARGIN_VOXELS * axi_dx[1];
     const double trusted =
@@ -369,20 +355,20 @@ void case_a2(Context& c) {
         // L∞, L1 as for the analytic flows (flow_errors.h), with each reference's φ. The
         // axisymmetric reference is the primary one ("error").
         const tracker::SurfaceError error =
-            tracker::surface_error(r.final_mesh, phi_of(refs.axis.back()));
+            tracker::surface_error(r.final_mesh, distance_of(refs.axis.back()));
         j["error"] = error_json(error);
         j["error_within_reference_band"] = error.linf < axi_trusted;
         j["error_coarse_reference"] =
-            error_json(tracker::surface_error(r.final_mesh, phi_of(refs.axis.front())));
+            error_json(tracker::surface_error(r.final_mesh, distance_of(refs.axis.front())));
         j["reference_difference"] = error_json(tracker::surface_error(
             r.final_mesh, difference_of(refs.axis.front(), refs.axis.back())));
         j["reference"] = refs.axis_json;
         const tracker::SurfaceError vdb_error =
-            tracker::surface_error(r.final_mesh, phi_of(refs.vdb.back()));
+            tracker::surface_error(r.final_mesh, distance_of(refs.vdb.back()));
         j["openvdb_error"] = error_json(vdb_error);
         j["openvdb_error_within_reference_band"] = vdb_error.linf < trusted;
         j["openvdb_error_coarse_reference"] =
-            error_json(tracker::surface_error(r.final_mesh, phi_of(refs.vdb.front())));
+            error_json(tracker::surface_error(r.final_mesh, distance_of(refs.vdb.front())));
         j["openvdb_reference_difference"] = error_json(
             tracker::surface_error(r.final_mesh, difference_of(refs.vdb.front(), refs.vdb.back())));
         j["openvdb_reference"] = refs.vdb_json;
