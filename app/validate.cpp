@@ -207,6 +207,10 @@ void case_a2(Context& c) {
     mcf_tracker.remesh.collapse_preserves_volume = MCF_COLLAPSE_PRESERVES_VOLUME;
     mcf_tracker.remesh.curvature_edge_fraction = MCF_CURVATURE_EDGE_FRACTION;
     mcf_tracker.remesh.split_on_fitted_surface = MCF_CURVATURE_EDGE_FRACTION > 0.0;
+    mcf_tracker.remesh.smoothing_onto_fitted_surface = MCF_FITTED_SMOOTHING;
+    mcf_tracker.remesh.smoothing_fit_degree = MCF_SMOOTHING_FIT_DEGREE;
+    mcf_tracker.remesh.smoothing_fit_max_turn = MCF_SMOOTHING_FIT_MAX_TURN;
+    mcf_tracker.remesh.collapse_on_fitted_surface = MCF_COLLAPSE_ON_FITTED_SURFACE;
     const auto mcf_run = [&](const char* label, double xi, tracker::ShapePtr shape,
                              const tracker::TrackerOptions& tracker, double t_end) {
         RunSpec s;

@@ -50,6 +50,33 @@ inline constexpr bool MCF_HEUN = true;
 /// so the sphere run to 0.9 of its extinction time at ξ = 0.04 lagged by vertex L∞ 2.28e-3
 /// (3.1e-4 without) and the dumbbell by 1.48e-2 (3.95e-3 without, both forward Euler).
 inline constexpr bool MCF_COLLAPSE_PRESERVES_VOLUME = false;
+/// A2 keeps vertices on the smooth surface while the shrinking drops are remeshed: smoothing
+/// moves a smooth vertex along a cubic height field fitted over its two-ring where that fit
+/// turns by at most MCF_SMOOTHING_FIT_MAX_TURN (elsewhere — the thin neck, a just-pinched tip —
+/// the tangent-plane move), and collapses put the merged vertex on the fitted surface
+/// (RemeshOptions::smoothing_onto_fitted_surface, smoothing_fit_degree, smoothing_fit_max_turn,
+/// collapse_on_fitted_surface). The tangent plane of the quadric's area-weighted normal leans
+/// into the surface where a collapse left larger triangles on one side, which is where
+/// smoothing moves the vertex, so plain smoothing sank every drop vertex. Dumbbell at
+/// t = 0.025, vertex L∞, vertex L1 and mean signed φ, against the axisymmetric reference at
+/// Δx = 0.0025 (ξ = 0.04) and 0.000625 (ξ = 0.02, 0.01):
+///
+///   ξ      tangent plane, butterfly      fitted smoothing and collapses   paper (its measure)
+///   0.04   4.87e-4  2.23e-4  −1.81e-4    4.84e-4  1.79e-4  −7.69e-5       6.18e-4  2.62e-4
+///   0.02   1.56e-4  7.02e-5  −6.94e-5    1.40e-4  4.48e-5  −1.67e-5       1.44e-4  7.03e-5
+///   0.01   3.63e-5  2.31e-5  −2.31e-5    4.54e-5  1.28e-5  −6.3e-6        1.48e-5  1.55e-5
+///
+/// Fitted collapses alone (ξ = 0.04: 5.43e-4, 1.84e-4, −1.18e-4; ξ = 0.02 against Δx = 0.00125:
+/// 1.78e-4, 9.52e-5, −9.52e-5) do not stop the sinking; a quadratic fit instead of the cubic
+/// drifts every vertex outwards (ξ = 0.04: 1.44e-3, 6.19e-4, +6.19e-4; see
+/// RemeshOptions::smoothing_fit_degree). What is left is the inner tip of each drop, outside
+/// (late) at every ξ: the tips retract at hundreds of m/s just after the pinch. With the
+/// sinking gone it is no longer hidden: at ξ = 0.01 the tangent-plane run's most outward vertex
+/// was still inside (φ ≤ −7e-6), the fitted run's tip is 4.5e-5 outside.
+inline constexpr bool MCF_FITTED_SMOOTHING = true;
+inline constexpr int MCF_SMOOTHING_FIT_DEGREE = 3;
+inline constexpr double MCF_SMOOTHING_FIT_MAX_TURN = 0.6;  ///< radians over the two-ring
+inline constexpr bool MCF_COLLAPSE_ON_FITTED_SURFACE = true;
 /// A2 runs refine where the surface turns sharply (RemeshOptions::curvature_edge_fraction c,
 /// with split_on_fitted_surface, which it needs; s_min stays at its default 0.25): edges turn
 /// by at most about c radians, so the thinning neck keeps about 2π/c edges around it instead of

@@ -27,7 +27,9 @@ namespace {
 using namespace flow_validation;
 using Json = nlohmann::json;
 
-std::string fmt(double v, const char* f = "%.6g") { return format_number(v, f); }
+std::string fmt(double v, const char* f = "%.6g") {
+    return format_number(v, f);
+}
 
 /// "remeshing / motion / collisions" volume change in % of the initial volume (see
 /// VolumeBudget in validate.cpp).
@@ -173,13 +175,27 @@ void report_a5(std::ostringstream& md, const Json& results) {
 }
 
 /// How the A2 runs size their edges, as a clause of the report's setup sentences.
+/// How A2's remeshing keeps vertices on the smooth surface (app/validate_parameters.h).
+std::string mcf_smoothing_text() {
+    std::string text;
+    if (MCF_COLLAPSE_ON_FITTED_SURFACE && !MCF_COLLAPSE_PRESERVES_VOLUME)
+        text += ", collapses onto a surface fitted to the edge's neighbours";
+    if (MCF_FITTED_SMOOTHING)
+        text += ", smoothing along a " +
+                std::string(MCF_SMOOTHING_FIT_DEGREE == 3 ? "cubic" : "quadratic") +
+                " height field fitted over each vertex's two-ring where it turns by at most " +
+                fmt(MCF_SMOOTHING_FIT_MAX_TURN) +
+                " rad (elsewhere in the tangent plane), so the shrinking drops' vertices stay "
+                "on the surface while their rings are remeshed";
+    return text;
+}
+
 std::string mcf_sizing_text() {
     if (MCF_CURVATURE_EDGE_FRACTION <= 0.0)
         return "";
     return ", and curvature-adaptive sizing (not in the paper): edges shorter where the surface "
            "turns, by at most " +
-           fmt(MCF_CURVATURE_EDGE_FRACTION) +
-           " rad per edge and down to " +
+           fmt(MCF_CURVATURE_EDGE_FRACTION) + " rad per edge and down to " +
            fmt(tracker::RemeshOptions{}.min_curvature_size_fraction) +
            " α and β, so the thinning neck keeps its edges around it and pinches on time";
 }
@@ -191,7 +207,7 @@ void report_a2(std::ostringstream& md, Json& results) {
        << (MCF_HEUN ? "Heun's method" : "forward Euler")
        << " with the CFL step, α = 1.5ξ, β = 0.5ξ, γ = 0.1ξ³"
        << (MCF_COLLAPSE_PRESERVES_VOLUME ? "" : ", collapses on the smooth surface")
-       << mcf_sizing_text()
+       << mcf_smoothing_text() << mcf_sizing_text()
        << ".\n\n| ξ | R₀ | t | steps | exact R(t) | L∞ | L1 | vertex L∞ | vertex L∞ / R | "
           "volume change % | exact volume change % | max intersecting pairs "
           "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -227,15 +243,12 @@ void report_a2(std::ostringstream& md, Json& results) {
         for (const Json& r : op) {
             const int pi = paper_index(r["xi_requested"].get<double>());
             md << "| " << fmt(r["xi_requested"]) << " | " << r["steps"].get<long>() << " | "
-               << r["triangles_max"].get<int>() << " | " << fmt(r["error"]["vertex_linf"])
-               << " | " << fmt(r["error"]["vertex_l1"]) << " | "
-               << fmt(r["error"]["vertex_max_signed"]) << ", "
-               << fmt(r["error"]["vertex_mean_signed"]) << " | " << fmt(r["error"]["linf"])
-               << ", " << fmt(r["error"]["l1"]) << " | "
-               << fmt(r["reference_difference"]["linf"]) << ", "
-               << fmt(r["reference_difference"]["l1"]) << " | "
-               << (pi >= 0 ? fmt(PAPER_A2_LINF[pi]) + ", " + fmt(PAPER_A2_L1[pi]) : "—")
-               << " |\n";
+               << r["triangles_max"].get<int>() << " | " << fmt(r["error"]["vertex_linf"]) << " | "
+               << fmt(r["error"]["vertex_l1"]) << " | " << fmt(r["error"]["vertex_max_signed"])
+               << ", " << fmt(r["error"]["vertex_mean_signed"]) << " | " << fmt(r["error"]["linf"])
+               << ", " << fmt(r["error"]["l1"]) << " | " << fmt(r["reference_difference"]["linf"])
+               << ", " << fmt(r["reference_difference"]["l1"]) << " | "
+               << (pi >= 0 ? fmt(PAPER_A2_LINF[pi]) + ", " + fmt(PAPER_A2_L1[pi]) : "—") << " |\n";
         }
         md << "\n";
         Json orders = Json::array();
@@ -267,9 +280,12 @@ void report_a2(std::ostringstream& md, Json& results) {
        << (MCF_COLLAPSE_PRESERVES_VOLUME ? "volume-keeping collapses"
                                          : "collapses that keep the new vertex on the smooth "
                                            "surface (not volume-keeping)")
-       << mcf_sizing_text()
+       << mcf_smoothing_text() << mcf_sizing_text()
        << "; see `app/validate_parameters.h` for what each choice changed. Our pinch-off time "
-          "is in the table; the reference's neck closes at t = 0.021925 (Δx = 0.0025).\n\n"
+          "is in the table; the reference's neck closes at t = 0.021925 (Δx = 0.00125: its "
+          "neck radius is 6.8e-3 at t = 0.0219 and 3.0e-3 at 0.02192, and r² falls linearly), "
+          "after which its tips retract at about 800 m/s (t ≈ 0.02194), 320 m/s (t ≈ 0.022) "
+          "and 140 m/s on average from t = 0.022 to 0.0225.\n\n"
        << "**The paper's error measure** (its released `meancurvature.cpp`): the reference's "
           "signed distance φ (cubic interpolation of its grid) at the mesh vertices only; "
           "\"L∞\" = max φ (signed: vertices inside the reference do not count) and \"L1\" = the "
@@ -323,9 +339,9 @@ void report_a2(std::ostringstream& md, Json& results) {
            << (r["error_within_reference_band"].get<bool>() ? "" : " (beyond the band)") << " | "
            << (pi >= 0 ? fmt(PAPER_A2_LINF[pi]) : "—") << " | " << fmt(r["error"]["l1"]) << " | "
            << (pi >= 0 ? fmt(PAPER_A2_L1[pi]) : "—") << " | " << fmt(r["error"]["vertex_linf"])
-           << " | " << fmt(r["error"]["vertex_l1"]) << " | "
-           << fmt(r["error"]["vertex_max_signed"]) << ", " << fmt(r["error"]["vertex_mean_signed"])
-           << " | " << fmt(r["error_coarse_reference"]["linf"]) << ", "
+           << " | " << fmt(r["error"]["vertex_l1"]) << " | " << fmt(r["error"]["vertex_max_signed"])
+           << ", " << fmt(r["error"]["vertex_mean_signed"]) << " | "
+           << fmt(r["error_coarse_reference"]["linf"]) << ", "
            << fmt(r["error_coarse_reference"]["l1"]) << " | "
            << fmt(r["reference_difference"]["linf"]) << ", " << fmt(r["reference_difference"]["l1"])
            << " | " << fmt(r["openvdb_error"]["linf"])

@@ -114,7 +114,9 @@ struct RemeshOptions {
     /// error first order in the drift: on the A2 dumbbell at ξ = 0.02 fitted quadratic
     /// smoothing left every vertex outside by t = 0.025 (mean 2.2e-4), and tangent-plane
     /// smoothing every drop vertex inside (mean −6.6e-5; on a sphere shrunk to R = 0.1 by
-    /// collapses −8.7e-5). The cubic: +3.0e-5 and −6.6e-6. 2 by default (A1 was measured with it).
+    /// collapses −8.7e-5). The cubic: +3.0e-5 and −6.6e-6. 2 by default (A1 was measured with it);
+    /// A2 uses 3 with smoothing_fit_max_turn 0.6 and collapse_on_fitted_surface (dumbbell at
+    /// ξ = 0.02: mean −1.7e-5, app/validate_parameters.h).
     int smoothing_fit_degree = 2;
     /// With smoothing_onto_fitted_surface, fitted moves only where the fit turns by at most
     /// this over its patch (SurfacePatch::turn(), radians, ≥ 0; 0: no bound); every other
