@@ -253,6 +253,36 @@ TEST(Separation, RemovesDegenerateTetrahedraAndSplitsSingularVertices) {
     EXPECT_EQ(flat.count_live_triangles(), 0);
 }
 
+TEST(Separation, SplitsTwoSheetsThatShareAnEdge) {
+    // Regression (issue #5): a dumbbell neck refined to an eighth of α and β (ξ = 0.02) collapsed
+    // into two sheets sharing an edge of 4e-5 m with four triangles. Its triangles all counted as
+    // one fan, so its vertices were never split, no collapse could remove it, and the CFL step
+    // of 0.1·(4e-5)² stalled the flow at the pinch. Two cubes sharing an edge are the same
+    // configuration: separation must pull them apart.
+    SurfaceMesh cubes = testing::make_test_edge_sharing_cubes();
+    int nonmanifold = 0;
+    for (int ei = 0; ei < cubes.num_edges(); ++ei)
+        nonmanifold += cubes.edge_alive(ei) && cubes.is_nonmanifold_edge(ei) ? 1 : 0;
+    ASSERT_GT(nonmanifold, 0);
+    ASSERT_EQ(triangle_components(cubes).count, 1);
+    const double volume = enclosed_volume(cubes);
+    const SeparationReport r = separate(cubes, SeparationOptions{}, true, 0.1);
+    EXPECT_EQ(r.refused_intersection, 0);
+    EXPECT_EQ(r.singular_vertices_split, nonmanifold + 1);  // the shared edge's vertices
+    for (int ei = 0; ei < cubes.num_edges(); ++ei)
+        EXPECT_FALSE(cubes.edge_alive(ei) && cubes.is_nonmanifold_edge(ei)) << "edge " << ei;
+    EXPECT_TRUE(validate_mesh(cubes).empty());
+    EXPECT_TRUE(is_intersection_free(cubes));
+    EXPECT_EQ(triangle_components(cubes).count, 2);
+    EXPECT_EQ(euler_characteristic(cubes), 4);  // two spheres
+    EXPECT_NEAR(enclosed_volume(cubes), volume, 1e-3 * volume);
+
+    // A manifold mesh keeps one fan per vertex.
+    SurfaceMesh sphere = testing::make_test_sphere();
+    const SeparationReport none = separate(sphere, SeparationOptions{}, true, 0.1);
+    EXPECT_EQ(none.singular_vertices_split, 0);
+}
+
 TEST(OpenSurfaces, BoundaryTakesPartInNoMerge) {
     // An open cap next to a sphere: boundary edges never take part in merges.
     SurfaceMesh cap = testing::make_test_open_cap();

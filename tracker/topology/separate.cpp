@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <numeric>
@@ -60,6 +61,61 @@ int remove_degenerate_tetrahedra(SurfaceMesh& mesh) {
     return removed;
 }
 
+/// The pairs of triangles around live edge `ei` that bound one wedge of the inside: around
+/// (a, b) = its vertices, e = b − a, sorted by the angle of their third vertex about e, a
+/// triangle wound a → b has the inside just clockwise of it and one wound b → a just
+/// counterclockwise, so each b → a triangle pairs with the next one counterclockwise, which must
+/// be wound a → b. On a manifold edge that is its two triangles. On a non-manifold edge (2k
+/// triangles: two sheets that a pinch or a collapse brought together along it) it is k pairs, one
+/// per sheet, so the sheets' vertices count as separate fans. Where the windings do not alternate
+/// (not an oriented surface there) every triangle is paired with the first: one fan, as before.
+std::vector<std::pair<int, int>> wedge_pairs(const SurfaceMesh& mesh, int ei) {
+    const std::vector<int>& et = mesh.edge_triangles(ei);
+    std::vector<std::pair<int, int>> pairs;
+    if (et.size() <= 2) {
+        if (et.size() == 2)
+            pairs.emplace_back(et[0], et[1]);
+        return pairs;
+    }
+    const Edge& edge = mesh.edge(ei);
+    const Vec3& a = mesh.position(edge[0]);
+    const Vec3 e = (mesh.position(edge[1]) - a).normalized();
+    // Any unit vector perpendicular to e, and its quarter turn about e.
+    const Vec3 u = e.unitOrthogonal(), w = e.cross(u);
+    struct Fin {
+        double angle;
+        bool a_to_b;
+        int ti;
+    };
+    std::vector<Fin> fins;
+    for (int ti : et) {
+        const Triangle& t = mesh.triangle(ti);
+        int c = -1;
+        bool a_to_b = false;
+        for (int k = 0; k < 3; ++k) {
+            if (t[k] != edge[0] && t[k] != edge[1])
+                c = t[k];
+            a_to_b = a_to_b || (t[k] == edge[0] && t[(k + 1) % 3] == edge[1]);
+        }
+        const Vec3 d = mesh.position(c) - a;
+        fins.push_back({std::atan2(d.dot(w), d.dot(u)), a_to_b, ti});
+    }
+    std::sort(fins.begin(), fins.end(),
+              [](const Fin& x, const Fin& y) { return x.angle < y.angle; });
+    const size_t n = fins.size();
+    for (size_t k = 0; k < n; ++k)
+        if (fins[k].a_to_b == fins[(k + 1) % n].a_to_b) {  // windings do not alternate
+            pairs.clear();
+            for (size_t j = 1; j < n; ++j)
+                pairs.emplace_back(et[0], et[j]);
+            return pairs;
+        }
+    for (size_t k = 0; k < n; ++k)
+        if (!fins[k].a_to_b)
+            pairs.emplace_back(fins[k].ti, fins[(k + 1) % n].ti);
+    return pairs;
+}
+
 Vec3 fan_centroid(const SurfaceMesh& mesh, const std::vector<int>& fan, int vi) {
     Vec3 sum = Vec3::Zero();
     int count = 0;
@@ -81,14 +137,12 @@ std::vector<std::vector<int>> vertex_fans(const SurfaceMesh& mesh, int vi) {
     auto local = [&](int ti) {
         return static_cast<int>(std::find(tris.begin(), tris.end(), ti) - tris.begin());
     };
-    for (int ei : mesh.vertex_edges(vi)) {
-        const auto& et = mesh.edge_triangles(ei);
-        for (size_t k = 1; k < et.size(); ++k) {
-            const int a = find_root(parent, local(et[0]));
-            const int b = find_root(parent, local(et[k]));
+    for (int ei : mesh.vertex_edges(vi))
+        for (const auto& [t0, t1] : wedge_pairs(mesh, ei)) {
+            const int a = find_root(parent, local(t0));
+            const int b = find_root(parent, local(t1));
             parent[static_cast<size_t>(a)] = b;
         }
-    }
     // The common case, one fan, without grouping.
     const int first_root = tris.empty() ? 0 : find_root(parent, 0);
     bool single_fan = true;

@@ -26,7 +26,9 @@ struct SeparationReport {
 };
 
 /// The triangle fans around vertex vi: groups of its triangles connected through edges
-/// incident to vi. More than one fan means vi is singular.
+/// incident to vi. More than one fan means vi is singular. Across a non-manifold edge (two
+/// sheets brought together along it) triangles connect only in the pairs that bound one wedge
+/// of the inside, so each sheet is its own fan and the edge's vertices are split too.
 std::vector<std::vector<int>> vertex_fans(const SurfaceMesh& mesh, int vi);
 
 /// Removes degenerate tetrahedra and orphaned vertices, then splits singular vertices. With
