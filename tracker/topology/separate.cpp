@@ -137,12 +137,19 @@ std::vector<std::vector<int>> vertex_fans(const SurfaceMesh& mesh, int vi) {
     auto local = [&](int ti) {
         return static_cast<int>(std::find(tris.begin(), tris.end(), ti) - tris.begin());
     };
-    for (int ei : mesh.vertex_edges(vi))
-        for (const auto& [t0, t1] : wedge_pairs(mesh, ei)) {
-            const int a = find_root(parent, local(t0));
-            const int b = find_root(parent, local(t1));
-            parent[static_cast<size_t>(a)] = b;
-        }
+    const auto join = [&](int t0, int t1) {
+        const int a = find_root(parent, local(t0));
+        const int b = find_root(parent, local(t1));
+        parent[static_cast<size_t>(a)] = b;
+    };
+    for (int ei : mesh.vertex_edges(vi)) {
+        const std::vector<int>& et = mesh.edge_triangles(ei);
+        if (et.size() == 2)
+            join(et[0], et[1]);  // manifold: the common case, without sorting
+        else if (et.size() > 2)
+            for (const auto& [t0, t1] : wedge_pairs(mesh, ei))
+                join(t0, t1);
+    }
     // The common case, one fan, without grouping.
     const int first_root = tris.empty() ? 0 : find_root(parent, 0);
     bool single_fan = true;
