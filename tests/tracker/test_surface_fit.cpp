@@ -224,10 +224,50 @@ TEST(SurfaceFit, CubicFitFallsBackToTheQuadraticOnSmallPatches) {
     const std::optional<SurfacePatch> patch =
         fit_surface_patch(mesh, all, triangles, Vec3::Zero(), Vec3::UnitZ(), cubic);
     ASSERT_TRUE(patch.has_value());
-    EXPECT_EQ(patch->coefficients.tail<4>(), (Eigen::Matrix<double, 4, 1>::Zero()));
+    EXPECT_EQ(patch->degree, 2);
+    EXPECT_EQ(patch->coefficients.tail<9>(), (Eigen::Matrix<double, 9, 1>::Zero()));
     for (int vi = 0; vi < 9; ++vi)
         EXPECT_NEAR((patch->point_above(mesh.position(vi)) - mesh.position(vi)).norm(), 0.0,
                     1e-12);
+}
+
+TEST(SurfaceFit, QuarticFitIsExactOnAQuarticGraphAndGivesItsCurvature) {
+    // A tilted quartic graph with a mixed term: the quartic fit reproduces it, its mean
+    // curvature and normal at the origin are the graph's, and a fit through the origin keeps
+    // c₀ = 0 while still reproducing it (the origin is on the graph).
+    const auto f = [](double x, double y) {
+        return 0.1 * x + 0.5 * x * x + 0.2 * x * y + 0.25 * y * y + 0.3 * x * x * x * x +
+               0.1 * x * x * y * y;
+    };
+    const SurfaceMesh mesh = graph_grid(4, 0.05, f);
+    std::vector<int> all(static_cast<size_t>(mesh.num_vertices()));
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        all[static_cast<size_t>(vi)] = vi;
+    std::vector<int> triangles(static_cast<size_t>(mesh.num_triangles()));
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        triangles[static_cast<size_t>(ti)] = ti;
+    // h_s = 0.1, h_t = 0, h_ss = 1, h_st = 0.2, h_tt = 0.5 in any frame (u, v) rotated about z:
+    // κ = −((1 + h_t²) h_ss − 2 h_s h_t h_st + (1 + h_s²) h_tt) / (1 + h_s² + h_t²)^{3/2}.
+    const double g = 1.0 + 0.01;
+    const double exact_kappa = -(1.0 + 1.01 * 0.5) / (g * std::sqrt(g));
+    const Vec3 exact_normal = Vec3(-0.1, 0.0, 1.0).normalized();
+    for (const bool through_origin : {false, true}) {
+        SurfaceFitOptions quartic;
+        quartic.degree = 4;
+        quartic.through_origin = through_origin;
+        const std::optional<SurfacePatch> patch =
+            fit_surface_patch(mesh, all, triangles, Vec3::Zero(), Vec3::UnitZ(), quartic);
+        ASSERT_TRUE(patch.has_value());
+        EXPECT_EQ(patch->degree, 4);
+        if (through_origin) {
+            EXPECT_EQ(patch->coefficients[0], 0.0);
+        }
+        for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+            EXPECT_NEAR((patch->point_above(mesh.position(vi)) - mesh.position(vi)).norm(), 0.0,
+                        1e-12);
+        EXPECT_NEAR(patch->mean_curvature(), exact_kappa, 1e-9);
+        EXPECT_NEAR((patch->surface_normal() - exact_normal).norm(), 0.0, 1e-10);
+    }
 }
 
 TEST(SurfaceFit, FittedSmoothingKeepsVerticesOnTheSphere) {
@@ -376,7 +416,7 @@ TEST(SurfaceFit, InvalidOptionsNameTheField) {
     o.max_residual_fraction = -1.0;
     EXPECT_NE(message(o).find("max_residual_fraction"), std::string::npos);
     o = {};
-    o.degree = 4;
+    o.degree = 5;
     EXPECT_NE(message(o).find("degree"), std::string::npos);
     RemeshOptions r;
     r.split_fit_residual_fraction = 0.0;

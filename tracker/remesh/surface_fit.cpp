@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace meniscus::tracker {
 
@@ -16,7 +17,8 @@ namespace {
 constexpr double RANK_TOLERANCE = 1e-6;
 constexpr int QUADRATIC_COEFFICIENTS = 6;
 constexpr int CUBIC_COEFFICIENTS = 10;
-using Coefficients = Eigen::Matrix<double, CUBIC_COEFFICIENTS, 1>;
+constexpr int QUARTIC_COEFFICIENTS = 15;
+using Coefficients = Eigen::Matrix<double, QUARTIC_COEFFICIENTS, 1>;
 /// arc_edge_point(): the two vertex normals may be at most 120° apart, and the arc's half angle
 /// (between the chord and each end's tangent plane) at most 60°.
 constexpr double ARC_MIN_NORMAL_COSINE = -0.5;
@@ -28,11 +30,26 @@ Vec3 any_orthogonal(const Vec3& n) {
     return n.cross(axis).normalized();
 }
 
+/// The vertices where the mesh has them.
+struct MeshPositions {
+    const SurfaceMesh& mesh;
+    const Vec3& operator()(int vi) const { return mesh.position(vi); }
+};
+/// The vertices at given positions, one per vertex slot.
+struct GivenPositions {
+    const std::vector<Vec3>& positions;
+    const Vec3& operator()(int vi) const { return positions[static_cast<size_t>(vi)]; }
+};
+
 /// Area vector (twice the area, along the normal) of live triangle ti.
-Vec3 area_vector(const SurfaceMesh& mesh, int ti) {
+template <typename Positions>
+Vec3 area_vector(const SurfaceMesh& mesh, const Positions& position, int ti) {
     const Triangle& t = mesh.triangle(ti);
-    const Vec3& a = mesh.position(t[0]);
-    return (mesh.position(t[1]) - a).cross(mesh.position(t[2]) - a);
+    const Vec3& a = position(t[0]);
+    return (position(t[1]) - a).cross(position(t[2]) - a);
+}
+Vec3 area_vector(const SurfaceMesh& mesh, int ti) {
+    return area_vector(mesh, MeshPositions{mesh}, ti);
 }
 
 /// Appends the vertices of vi's triangles (vi included) to `out`.
@@ -43,24 +60,28 @@ void append_one_ring(const SurfaceMesh& mesh, int vi, std::vector<int>& out) {
             out.push_back(w);
 }
 
-/// Least-squares height field with N coefficients (6: quadratic, 10: cubic, in the order of
-/// the file comment) through `local` ((s, t, h) in the patch frame), in units of the patch
-/// radius: the scaled coefficients, zero-padded to 10, or nullopt where the design is
+/// Least-squares height field with N coefficients (6: quadratic, 10: cubic, 15: quartic, in the
+/// order of the file comment) through `local` ((s, t, h) in the patch frame), in units of the
+/// patch radius: the scaled coefficients, zero-padded to 15, or nullopt where the design is
 /// rank-deficient or a vertex is further than `max_residual_fraction` of the radius from it.
-template <int N>
+/// FIRST = 1 leaves c₀ out (it stays 0): the fit passes through the frame origin.
+template <int N, int FIRST>
 std::optional<Coefficients> solve_height_field(const std::vector<Eigen::Vector3d>& local,
                                                double radius, double max_residual_fraction) {
+    constexpr int M = N - FIRST;
     const double inv = 1.0 / radius;
-    using Row = Eigen::Matrix<double, N, 1>;
+    using Row = Eigen::Matrix<double, M, 1>;
     const auto design_row = [inv](const Eigen::Vector3d& l) {
         const double s = l.x() * inv, t = l.y() * inv;
+        const double ss = s * s, tt = t * t;
         Coefficients all;
-        all << 1.0, s, t, s * s, s * t, t * t, s * s * s, s * s * t, s * t * t, t * t * t;
-        return Row(all.template head<N>());
+        all << 1.0, s, t, ss, s * t, tt, ss * s, ss * t, s * tt, tt * t, ss * ss, ss * s * t,
+            ss * tt, s * tt * t, tt * tt;
+        return Row(all.template segment<M>(FIRST));
     };
     // Normal equations, every column O(1) in these units. Fixed-size keeps this off the heap;
     // it runs for every smooth vertex on every smoothing step.
-    Eigen::Matrix<double, N, N> normal_matrix = Eigen::Matrix<double, N, N>::Zero();
+    Eigen::Matrix<double, M, M> normal_matrix = Eigen::Matrix<double, M, M>::Zero();
     Row right = Row::Zero();
     for (const Eigen::Vector3d& l : local) {
         const Row row = design_row(l);
@@ -69,7 +90,7 @@ std::optional<Coefficients> solve_height_field(const std::vector<Eigen::Vector3d
     }
     normal_matrix = normal_matrix.template selfadjointView<Eigen::Lower>();
     // Pivoted LDLT of AᵀA: its pivots bound the squared singular values of A.
-    const Eigen::LDLT<Eigen::Matrix<double, N, N>> ldlt(normal_matrix);
+    const Eigen::LDLT<Eigen::Matrix<double, M, M>> ldlt(normal_matrix);
     const Row pivots = ldlt.vectorD().cwiseAbs();
     if (ldlt.info() != Eigen::Success || !(pivots.maxCoeff() > 0.0) ||
         pivots.minCoeff() < RANK_TOLERANCE * RANK_TOLERANCE * pivots.maxCoeff())
@@ -81,7 +102,7 @@ std::optional<Coefficients> solve_height_field(const std::vector<Eigen::Vector3d
     if (!(residual <= max_residual_fraction * radius))
         return std::nullopt;
     Coefficients padded = Coefficients::Zero();
-    padded.template head<N>() = scaled;
+    padded.template segment<M>(FIRST) = scaled;
     return padded;
 }
 
@@ -136,17 +157,32 @@ void SurfaceFitOptions::validate() const {
     if (!(max_residual_fraction > 0.0 && max_residual_fraction <= 1.0))
         throw std::invalid_argument("max_residual_fraction: expected a number in (0, 1], got " +
                                     std::to_string(max_residual_fraction));
-    if (degree != 2 && degree != 3)
-        throw std::invalid_argument("degree: expected 2 or 3, got " + std::to_string(degree));
+    if (degree < 2 || degree > 4)
+        throw std::invalid_argument("degree: expected 2, 3 or 4, got " + std::to_string(degree));
 }
 
 Vec3 SurfacePatch::point_above(const Vec3& x) const {
     const Vec3 r = x - origin;
     const double s = r.dot(u), t = r.dot(v);
     const auto& c = coefficients;
-    const double h = c[0] + c[1] * s + c[2] * t + c[3] * s * s + c[4] * s * t + c[5] * t * t +
-                     c[6] * s * s * s + c[7] * s * s * t + c[8] * s * t * t + c[9] * t * t * t;
+    const double ss = s * s, tt = t * t;
+    const double h = c[0] + c[1] * s + c[2] * t + c[3] * ss + c[4] * s * t + c[5] * tt +
+                     c[6] * ss * s + c[7] * ss * t + c[8] * s * tt + c[9] * tt * t +
+                     c[10] * ss * ss + c[11] * ss * s * t + c[12] * ss * tt + c[13] * s * tt * t +
+                     c[14] * tt * tt;
     return origin + s * u + t * v + h * normal;
+}
+
+double SurfacePatch::mean_curvature() const {
+    const auto& c = coefficients;
+    const double hs = c[1], ht = c[2], hss = 2.0 * c[3], hst = c[4], htt = 2.0 * c[5];
+    const double g = 1.0 + hs * hs + ht * ht;
+    return -((1.0 + ht * ht) * hss - 2.0 * hs * ht * hst + (1.0 + hs * hs) * htt) /
+           (g * std::sqrt(g));
+}
+
+Vec3 SurfacePatch::surface_normal() const {
+    return (normal - coefficients[1] * u - coefficients[2] * v).normalized();
 }
 
 double SurfacePatch::turn() const {
@@ -155,11 +191,13 @@ double SurfacePatch::turn() const {
     return radius * (0.5 * std::abs(a + c) + std::hypot(0.5 * (a - c), b));
 }
 
-std::optional<SurfacePatch> fit_surface_patch(const SurfaceMesh& mesh,
-                                              const std::vector<int>& vertices,
-                                              const std::vector<int>& triangles, const Vec3& origin,
-                                              const Vec3& normal,
-                                              const SurfaceFitOptions& options) {
+namespace {
+
+template <typename Positions>
+std::optional<SurfacePatch> fit_patch(const SurfaceMesh& mesh, const Positions& position,
+                                      const std::vector<int>& vertices,
+                                      const std::vector<int>& triangles, const Vec3& origin,
+                                      const Vec3& normal, const SurfaceFitOptions& options) {
     options.validate();
     const double normal_length = normal.norm();
     if (!(normal_length > 0.0))
@@ -172,7 +210,7 @@ std::optional<SurfacePatch> fit_surface_patch(const SurfaceMesh& mesh,
 
     const double min_cosine = std::cos(options.max_normal_angle_degrees * M_PI / 180.0);
     for (int ti : triangles) {
-        const Vec3 a = area_vector(mesh, ti);
+        const Vec3 a = area_vector(mesh, position, ti);
         const double length = a.norm();
         if (!(length > 0.0) || a.dot(patch.normal) < min_cosine * length)
             return std::nullopt;
@@ -190,30 +228,79 @@ std::optional<SurfacePatch> fit_surface_patch(const SurfaceMesh& mesh,
 
     std::vector<Eigen::Vector3d> local(ids.size());
     for (size_t i = 0; i < ids.size(); ++i) {
-        const Vec3 r = mesh.position(ids[i]) - origin;
+        const Vec3 r = position(ids[i]) - origin;
         local[i] = {r.dot(patch.u), r.dot(patch.v), r.dot(patch.normal)};
         patch.radius = std::max(patch.radius, std::hypot(local[i].x(), local[i].y()));
     }
     if (!(patch.radius > 0.0))
         return std::nullopt;
     const double inv = 1.0 / patch.radius;
+    // The highest degree asked for that the patch supports, falling back one degree at a time.
     std::optional<Coefficients> scaled;
-    if (options.degree == 3 && ids.size() >= static_cast<size_t>(CUBIC_COEFFICIENTS))
-        scaled = solve_height_field<CUBIC_COEFFICIENTS>(local, patch.radius,
-                                                        options.max_residual_fraction);
-    if (!scaled)
-        scaled = solve_height_field<QUADRATIC_COEFFICIENTS>(local, patch.radius,
-                                                            options.max_residual_fraction);
+    const auto solve = [&](auto coefficients) {
+        constexpr int n = decltype(coefficients)::value;
+        return options.through_origin
+                   ? solve_height_field<n, 1>(local, patch.radius, options.max_residual_fraction)
+                   : solve_height_field<n, 0>(local, patch.radius, options.max_residual_fraction);
+    };
+    const auto fits = [&](int degree, int coefficients) {
+        return !scaled && options.degree >= degree && ids.size() >= static_cast<size_t>(coefficients);
+    };
+    if (fits(4, QUARTIC_COEFFICIENTS)) {
+        scaled = solve(std::integral_constant<int, QUARTIC_COEFFICIENTS>{});
+        patch.degree = 4;
+    }
+    if (fits(3, CUBIC_COEFFICIENTS)) {
+        scaled = solve(std::integral_constant<int, CUBIC_COEFFICIENTS>{});
+        patch.degree = 3;
+    }
+    if (!scaled) {
+        scaled = solve(std::integral_constant<int, QUADRATIC_COEFFICIENTS>{});
+        patch.degree = 2;
+    }
     if (!scaled)
         return std::nullopt;
     // Back from units of the patch radius: a term of degree k scales by inv^k.
-    const Coefficients& f = *scaled;
-    patch.coefficients << f[0], f[1] * inv, f[2] * inv, f[3] * inv * inv, f[4] * inv * inv,
-        f[5] * inv * inv, f[6] * inv * inv * inv, f[7] * inv * inv * inv, f[8] * inv * inv * inv,
-        f[9] * inv * inv * inv;
+    static constexpr int TERM_DEGREE[QUARTIC_COEFFICIENTS] = {0, 1, 1, 2, 2, 2, 3, 3,
+                                                              3, 3, 4, 4, 4, 4, 4};
+    for (int k = 0; k < QUARTIC_COEFFICIENTS; ++k)
+        patch.coefficients[k] = (*scaled)[k] * std::pow(inv, TERM_DEGREE[k]);
     if (!patch.coefficients.allFinite())
         return std::nullopt;
     return patch;
+}
+
+template <typename Positions>
+std::optional<SurfacePatch> vertex_patch_at(const SurfaceMesh& mesh, const Positions& position,
+                                            int vi, const SurfaceFitOptions& options) {
+    if (mesh.vertex_triangles(vi).empty() || mesh.is_boundary_vertex(vi))
+        return std::nullopt;
+    // The one-ring alone (about 7 vertices) barely determines 6 coefficients: fit the two-ring.
+    std::vector<int> ring;
+    append_one_ring(mesh, vi, ring);
+    std::vector<int> vertices, triangles;
+    for (int w : ring) {
+        append_one_ring(mesh, w, vertices);
+        triangles.insert(triangles.end(), mesh.vertex_triangles(w).begin(),
+                         mesh.vertex_triangles(w).end());
+    }
+    // Repeats only repeat the graph check; not worth removing.
+    Vec3 normal = Vec3::Zero();
+    for (int ti : mesh.vertex_triangles(vi))
+        normal += area_vector(mesh, position, ti);
+    if (!(normal.norm() > 0.0))
+        return std::nullopt;
+    return fit_patch(mesh, position, vertices, triangles, position(vi), normal, options);
+}
+
+}  // namespace
+
+std::optional<SurfacePatch> fit_surface_patch(const SurfaceMesh& mesh,
+                                              const std::vector<int>& vertices,
+                                              const std::vector<int>& triangles, const Vec3& origin,
+                                              const Vec3& normal,
+                                              const SurfaceFitOptions& options) {
+    return fit_patch(mesh, MeshPositions{mesh}, vertices, triangles, origin, normal, options);
 }
 
 std::optional<Vec3> fitted_edge_point(const SurfaceMesh& mesh, int ei,
@@ -298,24 +385,15 @@ std::optional<SurfaceEdgePoint> surface_edge_point(const SurfaceMesh& mesh, int 
 
 std::optional<SurfacePatch> vertex_patch(const SurfaceMesh& mesh, int vi,
                                          const SurfaceFitOptions& options) {
-    if (mesh.vertex_triangles(vi).empty() || mesh.is_boundary_vertex(vi))
-        return std::nullopt;
-    // The one-ring alone (about 7 vertices) barely determines 6 coefficients: fit the two-ring.
-    std::vector<int> ring;
-    append_one_ring(mesh, vi, ring);
-    std::vector<int> vertices, triangles;
-    for (int w : ring) {
-        append_one_ring(mesh, w, vertices);
-        triangles.insert(triangles.end(), mesh.vertex_triangles(w).begin(),
-                         mesh.vertex_triangles(w).end());
-    }
-    // Repeats only repeat the graph check; not worth removing.
-    Vec3 normal = Vec3::Zero();
-    for (int ti : mesh.vertex_triangles(vi))
-        normal += area_vector(mesh, ti);
-    if (!(normal.norm() > 0.0))
-        return std::nullopt;
-    return fit_surface_patch(mesh, vertices, triangles, mesh.position(vi), normal, options);
+    return vertex_patch_at(mesh, MeshPositions{mesh}, vi, options);
+}
+
+std::optional<SurfacePatch> vertex_patch(const SurfaceMesh& mesh,
+                                         const std::vector<Vec3>& positions, int vi,
+                                         const SurfaceFitOptions& options) {
+    if (positions.size() != static_cast<size_t>(mesh.num_vertices()))
+        throw std::invalid_argument("positions: expected one per vertex slot");
+    return vertex_patch_at(mesh, GivenPositions{positions}, vi, options);
 }
 
 std::optional<Vec3> place_on_vertex_patch(const SurfacePatch& patch, const Vec3& x,
