@@ -21,6 +21,9 @@ const std::vector<std::string> NORMAL_SPEED_METHODS = {"face_offsetting", "verte
 const std::vector<std::pair<std::string, tracker::MeanCurvatureIntegrator>>
     MEAN_CURVATURE_INTEGRATORS = {{"forward_euler", tracker::MeanCurvatureIntegrator::forward_euler},
                                   {"heun", tracker::MeanCurvatureIntegrator::heun}};
+const std::vector<std::pair<std::string, tracker::CurvatureOperator>> CURVATURE_OPERATORS = {
+    {"cotangent", tracker::CurvatureOperator::cotangent},
+    {"quartic_fit", tracker::CurvatureOperator::quartic_fit}};
 const std::vector<std::string> EXACT_TYPES = {"none", "two_sphere_normal_flow",
                                               "sphere_mean_curvature"};
 
@@ -215,6 +218,14 @@ void visit_fields(V& v, FlowOptions& o) {
         enum_field(r, "integrator", o.mean_curvature.integrator, MEAN_CURVATURE_INTEGRATORS,
                    "`forward_euler` (the paper's) or `heun` (second order in time, two curvature "
                    "evaluations per step, same stability limit)");
+        enum_field(r, "curvature_operator", o.mean_curvature.curvature_operator,
+                   CURVATURE_OPERATORS,
+                   "`cotangent` (Meyer et al., the paper's) or `quartic_fit` (κ n of a quartic "
+                   "height field fitted over each vertex's two-ring, pointwise fourth order on "
+                   "smooth patches; the cotangent formula where the fit turns by more than "
+                   "fit_max_turn)");
+        r.number("fit_max_turn", o.mean_curvature.fit_max_turn, Range::positive(), "rad",
+                 "quartic_fit: largest turn of the fitted two-ring for its curvature to be used");
     });
     v.section("curl_noise", "divergence-free pseudorandom field (type curl_noise)",
               [&](auto& r) { visit_fields(r, o.curl_noise); });

@@ -104,6 +104,17 @@ TEST(Scene, GeometricFlowKeys) {
     EXPECT_EQ(c.flow.curl_noise.rms_speed, 0.3);
     EXPECT_EQ(c.flow.curl_noise.time_frequency, 2.0);
     EXPECT_EQ(c.flow.curl_noise.octaves, tracker::CurlNoiseOptions{}.octaves);
+    const Scene m = parse_scene(R"({"surface": {"shape": {"type": "sphere"}},
+        "flow": {"type": "mean_curvature", "mean_curvature": {"integrator": "heun",
+                 "curvature_operator": "quartic_fit", "fit_max_turn": 0.5}}})",
+                                "t.json", ".");
+    EXPECT_EQ(m.flow.mean_curvature.integrator, tracker::MeanCurvatureIntegrator::heun);
+    EXPECT_EQ(m.flow.mean_curvature.curvature_operator, tracker::CurvatureOperator::quartic_fit);
+    EXPECT_EQ(m.flow.mean_curvature.fit_max_turn, 0.5);
+    EXPECT_EQ(parse_scene(R"({"surface": {"shape": {"type": "sphere"}}, "flow": {"type": "mean_curvature"}})",
+                          "t.json", ".")
+                  .flow.mean_curvature.curvature_operator,
+              tracker::CurvatureOperator::cotangent);
 }
 
 TEST(Scene, GeometricFlowErrorsNameTheJsonPath) {
@@ -122,6 +133,12 @@ TEST(Scene, GeometricFlowErrorsNameTheJsonPath) {
               std::string::npos);
     EXPECT_NE(error_with(R"("flow": {"type": "mean_curvature", "mean_curvature": {"integrator": "rk4"}})")
                   .find("/flow/mean_curvature/integrator: expected one of"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "mean_curvature", "mean_curvature": {"curvature_operator": "jet"}})")
+                  .find("/flow/mean_curvature/curvature_operator: expected one of"),
+              std::string::npos);
+    EXPECT_NE(error_with(R"("flow": {"type": "mean_curvature", "mean_curvature": {"fit_max_turn": 0}})")
+                  .find("/flow/mean_curvature/fit_max_turn: expected a number > 0"),
               std::string::npos);
     EXPECT_NE(error_with(R"("tracker": {"remesh": {"collapse_preserves_volume": 1}})")
                   .find("/tracker/remesh/collapse_preserves_volume: expected"),

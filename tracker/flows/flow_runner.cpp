@@ -60,7 +60,7 @@ MeanCurvatureStepper::MeanCurvatureStepper(const MeanCurvatureFlowOptions& optio
 FlowStep MeanCurvatureStepper::step(const SurfaceMesh& mesh, double /*t*/, double dt_max) const {
     const double cfl = mean_curvature_time_step(mesh, m_options);
     const double dt = std::min(dt_max, cfl);
-    return {mean_curvature_displacements(mesh, dt, m_options.integrator), dt, cfl < dt_max};
+    return {mean_curvature_displacements(mesh, dt, m_options), dt, cfl < dt_max};
 }
 
 FlowStep VelocityFieldStepper::step(const SurfaceMesh& mesh, double t, double dt_max) const {

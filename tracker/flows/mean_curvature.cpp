@@ -2,8 +2,12 @@
 
 #include "tracker/flows/vertex_normal_motion.h"
 #include "tracker/mesh_measures.h"
+#include "tracker/remesh/surface_fit.h"
+
+#include <tbb/parallel_for.h>
 
 #include <array>
+#include <atomic>
 #include <stdexcept>
 #include <string>
 
@@ -74,6 +78,11 @@ auto mesh_positions(const SurfaceMesh& mesh) {
     return [&mesh](int v) -> const Vec3& { return mesh.position(v); };
 }
 
+/// Vertices fitted per task of fitted_mean_curvature_normals(): a fit takes a few µs.
+constexpr int FIT_GRAIN = 256;
+/// The quartic needs 15 coefficients: degree 4 of SurfaceFitOptions.
+constexpr int QUARTIC_DEGREE = 4;
+
 /// K = (1 / 2A) Σ (cot α + cot β)(xᵢ − xⱼ) per vertex from the accumulated sums.
 std::vector<Vec3> curvature_normals(const SurfaceMesh& mesh, const CotangentSums& sums) {
     std::vector<Vec3> k(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
@@ -106,10 +115,55 @@ std::vector<double> mean_curvatures(const SurfaceMesh& mesh) {
     return kappa;
 }
 
+std::vector<Vec3> fitted_mean_curvature_normals(const SurfaceMesh& mesh, double max_turn,
+                                                const std::vector<Vec3>* positions,
+                                                int* fallbacks) {
+    if (!(max_turn > 0.0))
+        throw std::invalid_argument("max_turn: expected a number > 0 (radians), got " +
+                                    std::to_string(max_turn));
+    if (positions && positions->size() != static_cast<size_t>(mesh.num_vertices()))
+        throw std::invalid_argument("positions: expected one per vertex slot");
+    std::vector<Vec3> k =
+        positions ? curvature_normals(mesh, accumulate(mesh,
+                                                       [positions](int v) -> const Vec3& {
+                                                           return (*positions)[static_cast<size_t>(v)];
+                                                       }))
+                  : mean_curvature_normals(mesh);
+    SurfaceFitOptions fit;
+    fit.degree = QUARTIC_DEGREE;
+    fit.through_origin = true;  // the vertex is on the surface; its curvature is wanted
+    std::atomic<int> cotangent{0};
+    tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_vertices(), FIT_GRAIN),
+                      [&](const tbb::blocked_range<int>& range) {
+                          int local = 0;
+                          for (int vi = range.begin(); vi < range.end(); ++vi) {
+                              if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty() ||
+                                  mesh.is_boundary_vertex(vi))
+                                  continue;
+                              const std::optional<SurfacePatch> patch =
+                                  positions ? vertex_patch(mesh, *positions, vi, fit)
+                                            : vertex_patch(mesh, vi, fit);
+                              if (patch && patch->degree == QUARTIC_DEGREE &&
+                                  patch->turn() <= max_turn)
+                                  k[static_cast<size_t>(vi)] =
+                                      patch->mean_curvature() * patch->surface_normal();
+                              else
+                                  ++local;
+                          }
+                          cotangent += local;
+                      });
+    if (fallbacks)
+        *fallbacks = cotangent;
+    return k;
+}
+
 void MeanCurvatureFlowOptions::validate() const {
     if (!(cfl_number > 0.0 && cfl_number <= 1.0))
         throw std::invalid_argument("cfl_number: expected a number in (0, 1], got " +
                                     std::to_string(cfl_number));
+    if (!(fit_max_turn > 0.0))
+        throw std::invalid_argument("fit_max_turn: expected a number > 0 (radians), got " +
+                                    std::to_string(fit_max_turn));
 }
 
 double mean_curvature_time_step(const SurfaceMesh& mesh, const MeanCurvatureFlowOptions& options) {
@@ -124,6 +178,26 @@ std::vector<Vec3> mean_curvature_displacements(const SurfaceMesh& mesh, double d
     std::vector<Vec3> d = mean_curvature_normals(mesh);
     for (Vec3& v : d)
         v *= -dt;
+    return d;
+}
+
+std::vector<Vec3> mean_curvature_displacements(const SurfaceMesh& mesh, double dt,
+                                               const MeanCurvatureFlowOptions& options) {
+    options.validate();
+    if (options.curvature_operator == CurvatureOperator::cotangent)
+        return mean_curvature_displacements(mesh, dt, options.integrator);
+    std::vector<Vec3> d = fitted_mean_curvature_normals(mesh, options.fit_max_turn);
+    for (Vec3& v : d)
+        v *= -dt;
+    if (options.integrator == MeanCurvatureIntegrator::forward_euler)
+        return d;
+    std::vector<Vec3> predicted(d.size(), Vec3::Zero());
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        if (mesh.vertex_alive(vi))
+            predicted[static_cast<size_t>(vi)] = mesh.position(vi) + d[static_cast<size_t>(vi)];
+    const std::vector<Vec3> k = fitted_mean_curvature_normals(mesh, options.fit_max_turn, &predicted);
+    for (size_t i = 0; i < d.size(); ++i)
+        d[i] = 0.5 * (d[i] - dt * k[i]);
     return d;
 }
 
