@@ -246,6 +246,9 @@ void case_a2(Context& c) {
     if (MCF_HEUN)
         mcf.integrator = tracker::MeanCurvatureIntegrator::heun;
     const auto stepper = std::make_shared<tracker::MeanCurvatureStepper>(mcf);
+    tracker::MeanCurvatureFlowOptions fitted_mcf = mcf;
+    fitted_mcf.curvature_operator = tracker::CurvatureOperator::quartic_fit;
+    const auto fitted_stepper = std::make_shared<tracker::MeanCurvatureStepper>(fitted_mcf);
     tracker::TrackerOptions mcf_tracker = paper_tracker_options();
     mcf_tracker.remesh.collapse_preserves_volume = MCF_COLLAPSE_PRESERVES_VOLUME;
     mcf_tracker.remesh.curvature_edge_fraction = MCF_CURVATURE_EDGE_FRACTION;
@@ -254,15 +257,16 @@ void case_a2(Context& c) {
     mcf_tracker.remesh.smoothing_fit_degree = MCF_SMOOTHING_FIT_DEGREE;
     mcf_tracker.remesh.smoothing_fit_max_turn = MCF_SMOOTHING_FIT_MAX_TURN;
     mcf_tracker.remesh.collapse_on_fitted_surface = MCF_COLLAPSE_ON_FITTED_SURFACE;
-    const auto mcf_run = [&](const char* label, double xi, tracker::ShapePtr shape,
-                             const tracker::TrackerOptions& tracker, double t_end) {
+    const auto mcf_run = [&](const std::string& label, double xi, tracker::ShapePtr shape,
+                             const tracker::TrackerOptions& tracker, double t_end,
+                             bool quartic_fit = false) {
         RunSpec s;
         s.case_id = "A2";
-        s.label = label;
+        s.label = quartic_fit ? label + A2_QUARTIC_FIT_SUFFIX : label;
         s.xi_requested = xi;
         s.shape = std::move(shape);
         s.tracker = tracker;
-        s.stepper = stepper;
+        s.stepper = quartic_fit ? fitted_stepper : stepper;
         s.t_end = t_end;
         s.max_dt = MCF_MAX_DT;
         return run_tracked(s, c.quiet);
@@ -304,16 +308,18 @@ void case_a2(Context& c) {
         tracker::TrackerOptions fixed = mcf_tracker;
         fixed.remesh.split = fixed.remesh.flip = fixed.remesh.collapse = fixed.remesh.smooth =
             false;
-        for (double xi : xis) {
-            const RunResult r =
-                mcf_run("spheroid, no remeshing", xi, spheroid, fixed, MCF_SPHEROID_END);
-            Json j = run_json(r);
-            j["error"] = error_json(tracker::surface_error(r.final_mesh, distance_of(refs[1])));
-            j["reference_difference"] =
-                error_json(tracker::surface_error(r.final_mesh, difference_of(refs[0], refs[1])));
-            j["reference_voxel_size"] = dx[1];
-            c.add(std::move(j), r);
-        }
+        for (const bool quartic_fit : {false, true})
+            for (double xi : xis) {
+                const RunResult r = mcf_run("spheroid, no remeshing", xi, spheroid, fixed,
+                                            MCF_SPHEROID_END, quartic_fit);
+                Json j = run_json(r);
+                j["error"] =
+                    error_json(tracker::surface_error(r.final_mesh, distance_of(refs[1])));
+                j["reference_difference"] = error_json(
+                    tracker::surface_error(r.final_mesh, difference_of(refs[0], refs[1])));
+                j["reference_voxel_size"] = dx[1];
+                c.add(std::move(j), r);
+            }
     }
     // Dumbbell: the references (axisymmetric and OpenVDB, coarse and fine grid each) are
     // computed on a second thread while the meshes run; then each mesh is measured against them.
@@ -384,6 +390,9 @@ void case_a2(Context& c) {
     std::vector<RunResult> runs;
     for (double xi : dumbbell_xis)
         runs.push_back(mcf_run("dumbbell", xi, dumbbell, mcf_tracker, DUMBBELL_END));
+    if (c.full || A2_QUARTIC_FIT_DUMBBELL_IN_QUICK)
+        for (double xi : dumbbell_xis)
+            runs.push_back(mcf_run("dumbbell", xi, dumbbell, mcf_tracker, DUMBBELL_END, true));
     const References refs = pending.get();
     const double widest = widest_section(refs.axis.back(), DUMBBELL_SEPARATION, 0.5 * axi_dx[1]);
     const double axi_trusted =

@@ -75,6 +75,9 @@ constexpr double A2_QUICK_OPENVDB_REFERENCE_DIFFERENCE_BOUND = 1.2e-2;
 /// mesh's.
 constexpr double A2_SPHEROID_VERTEX_LINF_BOUND = 5e-4;
 constexpr double A2_SPHEROID_POLE_X = 0.15;
+/// The quartic-fit operator's vertex L∞ on that spheroid must be below this fraction of
+/// Meyer's.
+constexpr double A2_SPHEROID_QUARTIC_FIT_FRACTION = 0.5;
 /// Enright quick variant (period 1, ξ = 0.02): relative volume change bound, percent.
 constexpr double ENRIGHT_QUICK_VOLUME_PERCENT = 0.5;
 /// Enright quick: the surface returns near the initial sphere (L∞ distance, m; ξ = 0.02).
@@ -192,6 +195,21 @@ TEST_F(QuickValidation, MeyerOperatorAloneLagsAtTheSpheroidPoles) {
     EXPECT_GT(std::abs(e["vertex_linf_position"][0].get<double>()), A2_SPHEROID_POLE_X);
     EXPECT_GT(e["vertex_linf"].get<double>(),
               10.0 * s[0]["reference_difference"]["vertex_linf"].get<double>());
+}
+
+/// The quartic-fit operator on the same spheroid: its curvature converges pointwise, so the
+/// poles do not lag: measured vertex L∞ 1.19e-4 against Meyer's 3.02e-4 (its L1, 9.0e-5
+/// against 8.4e-5, is not better: at this ξ its one-signed error keeps the whole surface out).
+TEST_F(QuickValidation, QuarticFitOperatorBeatsMeyerOnTheSpheroid) {
+    const std::vector<Json> meyer = runs("A2", "spheroid, no remeshing");
+    const std::vector<Json> fitted = runs("A2", "spheroid, no remeshing, quartic fit");
+    ASSERT_EQ(meyer.size(), 1u);
+    ASSERT_EQ(fitted.size(), 1u);
+    const double e = fitted[0]["error"]["vertex_linf"].get<double>();
+    std::cout << "[ measured ] A2 spheroid ξ=0.04, no remeshing, quartic fit: vertex L∞ " << e
+              << " (Meyer " << meyer[0]["error"]["vertex_linf"] << ")\n";
+    EXPECT_LT(e, A2_SPHEROID_QUARTIC_FIT_FRACTION * meyer[0]["error"]["vertex_linf"].get<double>());
+    EXPECT_GT(e, fitted[0]["reference_difference"]["vertex_linf"].get<double>());
 }
 
 TEST_F(QuickValidation, DumbbellPinchesOffNearTheLevelSetReference) {
