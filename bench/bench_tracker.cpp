@@ -1,11 +1,13 @@
 // Broad phase, static intersection check and a whole collision-safe integrate() step at
-// 10k, 50k and 200k triangles (issue 3), and collision resolution on A4 curl-noise states. Meshes: spheres meshed at an edge length chosen for
+// 10k, 50k and 200k triangles (issue 3), collision resolution on A4 curl-noise states, and the
+// two mean-curvature operators (Meyer's cotangent K, the quartic two-ring fit) per evaluation. Meshes: spheres meshed at an edge length chosen for
 // the triangle count; motion: a smooth swirl plus a random jitter of 5 % of an edge per step.
 #include "tests/tracker/curl_noise_a4_states.h"
 #include "tracker/broadphase.h"
 #include "tracker/collision_resolution.h"
 #include "tracker/flows/curl_noise.h"
 #include "tracker/flows/flow_runner.h"
+#include "tracker/flows/mean_curvature.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/mesh_intersections.h"
 #include "tracker/mesh_io.h"
@@ -98,6 +100,26 @@ void BM_Integrate(benchmark::State& state) {
     state.counters["collisions_per_step"] =
         benchmark::Counter(collisions, benchmark::Counter::kAvgIterations);
 }
+
+/// One evaluation of the curvature normals of every vertex: arg 0 Meyer's cotangent formula,
+/// 1 the quartic fit (mean_curvature.h, CurvatureOperator).
+void BM_CurvatureNormals(benchmark::State& state) {
+    const SurfaceMesh& m = mesh_with(static_cast<int>(state.range(0)));
+    const bool fitted = state.range(1) == 1;
+    for (auto _ : state) {
+        const std::vector<Vec3> k =
+            fitted ? fitted_mean_curvature_normals(m, 1.0) : mean_curvature_normals(m);
+        benchmark::DoNotOptimize(k.data());
+    }
+    state.SetLabel(fitted ? "quartic fit" : "cotangent");
+    state.counters["triangles"] = m.num_triangles();
+}
+BENCHMARK(BM_CurvatureNormals)
+    ->Args({10000, 0})
+    ->Args({10000, 1})
+    ->Args({50000, 0})
+    ->Args({50000, 1})
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_BroadPhaseSwept)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StaticIntersectionCheck)
