@@ -58,6 +58,11 @@ std::vector<Json> select(const Json& runs, const std::string& id, const std::str
     return out;
 }
 
+/// "max, min" of one half of error_by_half (A2 dumbbell).
+std::string max_min(const Json& half) {
+    return fmt(half["max"]) + ", " + fmt(half["min"]);
+}
+
 std::string status(const Json& r) {
     return r["completed"].get<bool>() ? ""
                                       : " (stopped: " + r["stop_reason"].get<std::string>() + ")";
@@ -393,9 +398,8 @@ void report_a2(std::ostringstream& md, Json& results) {
     for (const Json& r : db) {
         const int pi = paper_index(r["xi_requested"].get<double>());
         const Json& h = r["error_by_half"];
-        md << "| " << fmt(r["xi_requested"]) << " | " << fmt(h["inner"]["max"]) << ", "
-           << fmt(h["inner"]["min"]) << " | " << fmt(h["outer"]["max"]) << ", "
-           << fmt(h["outer"]["min"]) << " | " << (pi >= 0 ? fmt(PAPER_A2_LINF[pi]) : "—") << " |\n";
+        md << "| " << fmt(r["xi_requested"]) << " | " << max_min(h["inner"]) << " | "
+           << max_min(h["outer"]) << " | " << (pi >= 0 ? fmt(PAPER_A2_LINF[pi]) : "—") << " |\n";
     }
     md << "\n";
     for (size_t i = 1; i < db.size(); ++i)
@@ -440,10 +444,8 @@ void report_a2(std::ostringstream& md, Json& results) {
                << (pi >= 0 ? fmt(PAPER_A2_L1[pi]) : "—") << " | "
                << fmt(r["error"]["vertex_max_signed"]) << ", "
                << fmt(r["error"]["vertex_mean_signed"]) << " | " << fmt(r["error"]["linf"])
-               << ", " << fmt(r["error"]["l1"]) << " | " << fmt(h["inner"]["max"]) << ", "
-               << fmt(h["inner"]["min"]) << " | " << fmt(h["outer"]["max"]) << ", "
-               << fmt(h["outer"]["min"]) << " | " << r["max_intersecting_pairs"].get<int>()
-               << " |\n";
+               << ", " << fmt(r["error"]["l1"]) << " | " << max_min(h["inner"]) << " | "
+               << max_min(h["outer"]) << " | " << r["max_intersecting_pairs"].get<int>() << " |\n";
         }
         md << "\n";
         Json fitted_orders = Json::array();
