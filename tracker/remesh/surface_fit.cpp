@@ -278,13 +278,20 @@ std::optional<SurfacePatch> vertex_patch_at(const SurfaceMesh& mesh, const Posit
     // The one-ring alone (about 7 vertices) barely determines 6 coefficients: fit the two-ring.
     std::vector<int> ring;
     append_one_ring(mesh, vi, ring);
+    // Each neighbour appears once per triangle it shares with vi: expand it once. Its later
+    // repeats only repeated ids already listed (the fit's vertex order is unchanged) and
+    // tripled the work of every fit.
     std::vector<int> vertices, triangles;
-    for (int w : ring) {
+    for (size_t i = 0; i < ring.size(); ++i) {
+        const int w = ring[i];
+        if (std::find(ring.begin(), ring.begin() + static_cast<std::ptrdiff_t>(i), w) !=
+            ring.begin() + static_cast<std::ptrdiff_t>(i))
+            continue;
         append_one_ring(mesh, w, vertices);
         triangles.insert(triangles.end(), mesh.vertex_triangles(w).begin(),
                          mesh.vertex_triangles(w).end());
     }
-    // Repeats only repeat the graph check; not worth removing.
+    // Triangles shared by neighbours repeat only the graph check; not worth removing.
     Vec3 normal = Vec3::Zero();
     for (int ti : mesh.vertex_triangles(vi))
         normal += area_vector(mesh, position, ti);
