@@ -52,7 +52,10 @@ inline constexpr bool MCF_HEUN = true;
 /// against the Δx = 0.000625 reference): ξ = 0.04 4.98e-4, 2.81e-4 (Meyer's 4.29e-4, 1.83e-4:
 /// the final drops, of radius ≈ 0.09, are barely wider than a two-ring there, and the fit's
 /// one-signed error leaves every drop outside, mean φ +2.8e-4); ξ = 0.02 5.87e-5, 2.22e-5
-/// (Meyer's 1.38e-4, 4.51e-5).
+/// (Meyer's 1.38e-4, 4.51e-5); ξ = 0.01 1.03e-5, 6.4e-6, every vertex inside by 2.6e-6 to
+/// 1.03e-5 (Meyer's 4.44e-5, 1.27e-5; the paper's 1.48e-5, 1.55e-5), measured on the scene
+/// a2_dumbbell_quartic_fit_xi0.01.json run with its steps cut at frame times (9133 steps,
+/// 112 min on 2 cores), not yet through `validate --full`.
 inline constexpr const char* A2_QUARTIC_FIT_SUFFIX = ", quartic fit";
 inline constexpr bool A2_QUARTIC_FIT_DUMBBELL_IN_QUICK = false;
 /// A2 collapses keep the new vertex at the butterfly point, on the smooth surface, instead of
