@@ -44,12 +44,15 @@ const char* USAGE =
     "        Ctrl-C stops after the current step; every file\n"
     "        already written is complete.\n"
     "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4|B1|B2|B3|B4|B5]... [--xi X]...\n"
+    "           [--curvature-operator cotangent|quartic_fit]...\n"
     "        run the validation cases — A: the paper's geometric flows, B: two-phase flow with\n"
     "        surface tension (quick: coarse, minutes; full: the references' resolutions, hours)\n"
     "        — and write report.md, results.json and plots into DIR\n"
     "        (default: validation/); --case runs only the named cases (repeatable);\n"
     "        --xi runs only the part-A runs at edge length X m (repeatable, e.g.\n"
-    "        --full --case A2 --xi 0.01); exit code 1 if a run failed or intersected\n"
+    "        --full --case A2 --xi 0.01); --curvature-operator runs A2 only with the named\n"
+    "        operators (repeatable; naming quartic_fit runs its dumbbell rows in quick mode\n"
+    "        too); exit code 1 if a run failed or intersected\n"
     "  scene-reference\n"
     "        print every scene key with its type, default, unit and meaning (Markdown)\n"
     "\n"
@@ -165,6 +168,8 @@ int dispatch(int argc, char** argv) {
                 options.cases.push_back(args[++i]);  // checked below with the rest
             else if (args[i] == "--xi" && i + 1 < args.size())
                 options.xis.push_back(parse_positive_length("--xi", args[++i]));
+            else if (args[i] == "--curvature-operator" && i + 1 < args.size())
+                options.curvature_operators.push_back(args[++i]);  // checked below
             else
                 throw UsageError("validate: unknown or incomplete option " + args[i]);
         }

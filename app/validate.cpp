@@ -99,11 +99,25 @@ struct Context {
     bool full = false;
     bool quiet = false;
     std::vector<double> xis;  ///< ValidateOptions::xis: empty runs every resolution
+    /// ValidateOptions::curvature_operators: empty runs both.
+    std::vector<std::string> curvature_operators;
 
     /// Whether a run at resolution `xi` is selected.
     bool runs_xi(double xi) const {
         return xis.empty() ||
                std::any_of(xis.begin(), xis.end(), [xi](double x) { return same_xi(x, xi); });
+    }
+    /// Whether A2 runs with the cotangent (false) or the quartic-fit (true) operator.
+    bool runs_operator(bool quartic_fit) const {
+        const std::string name = quartic_fit ? "quartic_fit" : "cotangent";
+        return curvature_operators.empty() ||
+               std::find(curvature_operators.begin(), curvature_operators.end(), name) !=
+                   curvature_operators.end();
+    }
+    /// Whether the quartic-fit dumbbell rows run: in full mode, or when named.
+    bool runs_quartic_dumbbell() const {
+        return runs_operator(true) &&
+               (full || A2_QUARTIC_FIT_DUMBBELL_IN_QUICK || !curvature_operators.empty());
     }
     Json runs = Json::array();
     bool all_ok = true;
@@ -275,7 +289,7 @@ void case_a2(Context& c) {
         const Vec3 center = Vec3::Zero();
         const double t_end = MCF_SPHERE_TIME_FRACTION * MCF_SPHERE_RADIUS * MCF_SPHERE_RADIUS / 4.0;
         for (double xi : a2_sphere_xis(c.full)) {
-            if (!c.runs_xi(xi))
+            if (!c.runs_xi(xi) || !c.runs_operator(false))
                 continue;
             const RunResult r = mcf_run(
                 "sphere", xi, tracker::make_sphere(center, MCF_SPHERE_RADIUS), mcf_tracker, t_end);
@@ -310,6 +324,8 @@ void case_a2(Context& c) {
             false;
         for (const bool quartic_fit : {false, true})
             for (double xi : xis) {
+                if (!c.runs_operator(quartic_fit))
+                    continue;
                 const RunResult r = mcf_run("spheroid, no remeshing", xi, spheroid, fixed,
                                             MCF_SPHEROID_END, quartic_fit);
                 Json j = run_json(r);
@@ -327,7 +343,7 @@ void case_a2(Context& c) {
     for (double xi : a2_dumbbell_xis(c.full))
         if (c.runs_xi(xi))
             dumbbell_xis.push_back(xi);
-    if (dumbbell_xis.empty())
+    if (dumbbell_xis.empty() || (!c.runs_operator(false) && !c.runs_quartic_dumbbell()))
         return;
     const tracker::ShapePtr dumbbell =
         tracker::make_dumbbell(Vec3::Zero(), DUMBBELL_BULB_RADIUS, DUMBBELL_SEPARATION,
@@ -388,9 +404,10 @@ void case_a2(Context& c) {
         return refs;
     });
     std::vector<RunResult> runs;
-    for (double xi : dumbbell_xis)
-        runs.push_back(mcf_run("dumbbell", xi, dumbbell, mcf_tracker, DUMBBELL_END));
-    if (c.full || A2_QUARTIC_FIT_DUMBBELL_IN_QUICK)
+    if (c.runs_operator(false))
+        for (double xi : dumbbell_xis)
+            runs.push_back(mcf_run("dumbbell", xi, dumbbell, mcf_tracker, DUMBBELL_END));
+    if (c.runs_quartic_dumbbell())
         for (double xi : dumbbell_xis)
             runs.push_back(mcf_run("dumbbell", xi, dumbbell, mcf_tracker, DUMBBELL_END, true));
     const References refs = pending.get();
@@ -548,6 +565,10 @@ void check_validate_options(const ValidateOptions& options) {
         if (!is_fluid_case(id) && id != "A1" && id != "A2" && id != "A3" && id != "A4")
             throw std::invalid_argument("validate: unknown case '" + id +
                                         "' (expected A1, A2, A3, A4 or B1 … B5)");
+    for (const std::string& name : options.curvature_operators)
+        if (name != "cotangent" && name != "quartic_fit")
+            throw std::invalid_argument("validate: unknown curvature operator '" + name +
+                                        "' (expected cotangent or quartic_fit)");
     for (double xi : options.xis) {  // each requested ξ must be one a selected case runs
         std::vector<double> offered;
         for (const char* id : {"A1", "A2", "A3", "A4"})
@@ -586,6 +607,7 @@ int run_validation(const ValidateOptions& options) {
             fluid_cases.push_back(id);
     const bool any_fluid_case = options.cases.empty() || !fluid_cases.empty();
     c.xis = options.xis;
+    c.curvature_operators = options.curvature_operators;
     if (case_selected(options, "A1"))
         case_a1(c);
     if (case_selected(options, "A2"))

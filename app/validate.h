@@ -25,10 +25,17 @@ struct ValidateOptions {
     /// --full for the finest row only); empty: all. A value no selected case runs is an
     /// std::invalid_argument before anything runs. Part B has no ξ and ignores this.
     std::vector<double> xis;
+    /// Curvature operators A2's mean-curvature runs use ("cotangent", Meyer's, the paper's;
+    /// "quartic_fit", tracker::CurvatureOperator); empty: both, with the quartic dumbbell rows
+    /// in full mode only (A2_QUARTIC_FIT_DUMBBELL_IN_QUICK). Naming "quartic_fit" runs its
+    /// dumbbell rows in quick mode too. The sphere rows are the cotangent operator's. An unknown
+    /// name is an std::invalid_argument before anything runs.
+    std::vector<std::string> curvature_operators;
 };
 
-/// Throws std::invalid_argument, naming the option, if `options` asks for an unknown case or a
-/// ξ that no selected case runs. run_validation() calls it before running anything.
+/// Throws std::invalid_argument, naming the option, if `options` asks for an unknown case, a
+/// ξ that no selected case runs or an unknown curvature operator. run_validation() calls it
+/// before running anything.
 void check_validate_options(const ValidateOptions& options);
 
 /// Runs the validation cases and writes the report. Returns a process exit code: 0 when every

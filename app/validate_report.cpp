@@ -205,6 +205,81 @@ std::string mcf_sizing_text() {
            " α and β, so the thinning neck keeps its edges around it and pinches on time";
 }
 
+/// The A2 dumbbell rows with Meyer's operator (the paper's): table, orders and where the error
+/// is, per drop half.
+void report_a2_cotangent_dumbbell(std::ostringstream& md, Json& results,
+                                  const std::vector<Json>& db) {
+    md << "| ξ | measured ξ | t | steps | triangles | pinch-off time | components at end | L∞ | "
+          "paper L∞ | L1 | paper L1 | vertex L∞ | vertex L1 | paper's measure: max φ, mean φ | "
+          "L∞, L1 vs coarse reference | "
+          "reference max, mean \\|φ_c − φ_f\\| | OpenVDB L∞, L1 | OpenVDB max, mean "
+          "\\|φ_c − φ_f\\| | max intersecting pairs |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const Json& r : db) {
+        const int pi = paper_index(r["xi_requested"].get<double>());
+        md << "| " << fmt(r["xi_requested"]) << " | " << fmt(r["xi"], "%.4f") << " | "
+           << fmt(r["t_reached"]) << status(r) << " | " << r["steps"].get<long>() << " | "
+           << r["triangles_min"].get<int>() << "–" << r["triangles_max"].get<int>() << " | "
+           << (r["pinch_off_time"].is_null() ? std::string("none") : fmt(r["pinch_off_time"]))
+           << " | " << r["final_components"].get<int>() << " | " << fmt(r["error"]["linf"])
+           << (r["error_within_reference_band"].get<bool>() ? "" : " (beyond the band)") << " | "
+           << (pi >= 0 ? fmt(PAPER_A2_LINF[pi]) : "—") << " | " << fmt(r["error"]["l1"]) << " | "
+           << (pi >= 0 ? fmt(PAPER_A2_L1[pi]) : "—") << " | " << fmt(r["error"]["vertex_linf"])
+           << " | " << fmt(r["error"]["vertex_l1"]) << " | " << fmt(r["error"]["vertex_max_signed"])
+           << ", " << fmt(r["error"]["vertex_mean_signed"]) << " | "
+           << fmt(r["error_coarse_reference"]["linf"]) << ", "
+           << fmt(r["error_coarse_reference"]["l1"]) << " | "
+           << fmt(r["reference_difference"]["linf"]) << ", " << fmt(r["reference_difference"]["l1"])
+           << " | " << fmt(r["openvdb_error"]["linf"])
+           << (r["openvdb_error_within_reference_band"].get<bool>() ? "" : " (beyond the band)")
+           << ", " << fmt(r["openvdb_error"]["l1"]) << " | "
+           << fmt(r["openvdb_reference_difference"]["linf"]) << ", "
+           << fmt(r["openvdb_reference_difference"]["l1"]) << " | "
+           << r["max_intersecting_pairs"].get<int>() << " |\n";
+    }
+    md << "\n";
+    Json orders = Json::array();
+    write_orders(md, db, "error", "linf", orders);
+    write_orders(md, db, "error", "l1", orders);
+    write_orders(md, db, "error", "vertex_linf", orders);
+    write_orders(md, db, "error", "vertex_l1", orders);
+    md << "paper's orders (Table 4.3): L∞ "
+       << fmt(observed_order(PAPER_A2_LINF[0], PAPER_A2_LINF[1], 0.04, 0.02), "%.2f") << ", "
+       << fmt(observed_order(PAPER_A2_LINF[1], PAPER_A2_LINF[2], 0.02, 0.01), "%.2f") << "; L1 "
+       << fmt(observed_order(PAPER_A2_L1[0], PAPER_A2_L1[1], 0.04, 0.02), "%.2f") << ", "
+       << fmt(observed_order(PAPER_A2_L1[1], PAPER_A2_L1[2], 0.02, 0.01), "%.2f") << "\n";
+    if (db.size() < 2)
+        md << "(one resolution only in this mode: no observed order; run `--full`.)\n";
+    results["orders"]["A2 dumbbell"] = orders;
+    md << "\n**Where the error is.** Each drop split at its widest section (|x| = "
+       << fmt(db.front()["error_by_half"]["split_x"], "%.3f")
+       << " in the reference): the inner half ends in the tip the pinch left, the outer half "
+          "in the far pole of the former bulb. Signed φ at the vertices (> 0: outside, late). "
+          "The poles lag as the spheroid's do (Meyer's operator where the curvature peaks); "
+          "the tips carry the pinch's own error.\n\n"
+          "| ξ | inner halves (tips): max φ, min φ | outer halves (poles): max φ, min φ | "
+          "paper L∞ |\n|---|---|---|---|\n";
+    for (const Json& r : db) {
+        const int pi = paper_index(r["xi_requested"].get<double>());
+        const Json& h = r["error_by_half"];
+        md << "| " << fmt(r["xi_requested"]) << " | " << max_min(h["inner"]) << " | "
+           << max_min(h["outer"]) << " | " << (pi >= 0 ? fmt(PAPER_A2_LINF[pi]) : "—") << " |\n";
+    }
+    md << "\n";
+    for (size_t i = 1; i < db.size(); ++i)
+        for (const char* half : {"inner", "outer"})
+            if (db[i - 1]["error_by_half"][half]["max"].get<double>() > 0.0 &&
+                db[i]["error_by_half"][half]["max"].get<double>() > 0.0)
+                md << "observed order (max φ, " << half << " halves, ξ "
+                   << fmt(db[i - 1]["xi_requested"]) << " → " << fmt(db[i]["xi_requested"])
+                   << "): **"
+                   << fmt(observed_order(db[i - 1]["error_by_half"][half]["max"].get<double>(),
+                                         db[i]["error_by_half"][half]["max"].get<double>(),
+                                         db[i - 1]["xi"].get<double>(), db[i]["xi"].get<double>()),
+                          "%.2f")
+                   << "**  \n";
+}
+
 void report_a2(std::ostringstream& md, Json& results) {
     md << "## A2 — motion by mean curvature (paper §4.2, Table 4.3)\n\n"
           "### Sphere against the exact R(t) = sqrt(R₀² − 4t)\n\n"
@@ -280,13 +355,16 @@ void report_a2(std::ostringstream& md, Json& results) {
     }
     md << "\n### Dumbbell\n\n";
     const std::vector<Json> db = select(results["runs"], "A2", "dumbbell");
-    if (db.empty()) {
+    const std::vector<Json> fitted =
+        select(results["runs"], "A2", std::string("dumbbell") + A2_QUARTIC_FIT_SUFFIX);
+    if (db.empty() && fitted.empty()) {
         md << "Not run (quick mode runs it only with `--full`, or it was left out by "
               "`--case`).\n\n";
         return;
     }
-    const Json& axi = db.front()["reference"];
-    const Json& vdb = db.front()["openvdb_reference"];
+    const Json& first = db.empty() ? fitted.front() : db.front();
+    const Json& axi = first["reference"];
+    const Json& vdb = first["openvdb_reference"];
     md << "The paper's dumbbell, from the scripts released with its code (El Topo's "
           "`talpa/sisc-scripts/mc-params-*.txt`): balls r = "
        << fmt(DUMBBELL_BULB_RADIUS) << " at ±" << fmt(DUMBBELL_SEPARATION / 2)
@@ -344,78 +422,11 @@ void report_a2(std::ostringstream& md, Json& results) {
        << " s). Kept beside the primary one; its own error (its two grids' difference) is "
           "far above the paper's targets near the pinched tips.\n\n"
           "L∞ = max |φ_ref| and L1 = area-weighted mean |φ_ref| over the final mesh's vertices "
-          "and 16 sample points per triangle (`tracker::surface_error`).\n\n"
-          "| ξ | measured ξ | t | steps | triangles | pinch-off time | components at end | L∞ | "
-          "paper L∞ | L1 | paper L1 | vertex L∞ | vertex L1 | paper's measure: max φ, mean φ | "
-          "L∞, L1 vs coarse reference | "
-          "reference max, mean \\|φ_c − φ_f\\| | OpenVDB L∞, L1 | OpenVDB max, mean "
-          "\\|φ_c − φ_f\\| | max intersecting pairs |\n"
-          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    for (const Json& r : db) {
-        const int pi = paper_index(r["xi_requested"].get<double>());
-        md << "| " << fmt(r["xi_requested"]) << " | " << fmt(r["xi"], "%.4f") << " | "
-           << fmt(r["t_reached"]) << status(r) << " | " << r["steps"].get<long>() << " | "
-           << r["triangles_min"].get<int>() << "–" << r["triangles_max"].get<int>() << " | "
-           << (r["pinch_off_time"].is_null() ? std::string("none") : fmt(r["pinch_off_time"]))
-           << " | " << r["final_components"].get<int>() << " | " << fmt(r["error"]["linf"])
-           << (r["error_within_reference_band"].get<bool>() ? "" : " (beyond the band)") << " | "
-           << (pi >= 0 ? fmt(PAPER_A2_LINF[pi]) : "—") << " | " << fmt(r["error"]["l1"]) << " | "
-           << (pi >= 0 ? fmt(PAPER_A2_L1[pi]) : "—") << " | " << fmt(r["error"]["vertex_linf"])
-           << " | " << fmt(r["error"]["vertex_l1"]) << " | " << fmt(r["error"]["vertex_max_signed"])
-           << ", " << fmt(r["error"]["vertex_mean_signed"]) << " | "
-           << fmt(r["error_coarse_reference"]["linf"]) << ", "
-           << fmt(r["error_coarse_reference"]["l1"]) << " | "
-           << fmt(r["reference_difference"]["linf"]) << ", " << fmt(r["reference_difference"]["l1"])
-           << " | " << fmt(r["openvdb_error"]["linf"])
-           << (r["openvdb_error_within_reference_band"].get<bool>() ? "" : " (beyond the band)")
-           << ", " << fmt(r["openvdb_error"]["l1"]) << " | "
-           << fmt(r["openvdb_reference_difference"]["linf"]) << ", "
-           << fmt(r["openvdb_reference_difference"]["l1"]) << " | "
-           << r["max_intersecting_pairs"].get<int>() << " |\n";
-    }
-    md << "\n";
-    Json orders = Json::array();
-    write_orders(md, db, "error", "linf", orders);
-    write_orders(md, db, "error", "l1", orders);
-    write_orders(md, db, "error", "vertex_linf", orders);
-    write_orders(md, db, "error", "vertex_l1", orders);
-    md << "paper's orders (Table 4.3): L∞ "
-       << fmt(observed_order(PAPER_A2_LINF[0], PAPER_A2_LINF[1], 0.04, 0.02), "%.2f") << ", "
-       << fmt(observed_order(PAPER_A2_LINF[1], PAPER_A2_LINF[2], 0.02, 0.01), "%.2f") << "; L1 "
-       << fmt(observed_order(PAPER_A2_L1[0], PAPER_A2_L1[1], 0.04, 0.02), "%.2f") << ", "
-       << fmt(observed_order(PAPER_A2_L1[1], PAPER_A2_L1[2], 0.02, 0.01), "%.2f") << "\n";
-    if (db.size() < 2)
-        md << "(one resolution only in this mode: no observed order; run `--full`.)\n";
-    results["orders"]["A2 dumbbell"] = orders;
-    md << "\n**Where the error is.** Each drop split at its widest section (|x| = "
-       << fmt(db.front()["error_by_half"]["split_x"], "%.3f")
-       << " in the reference): the inner half ends in the tip the pinch left, the outer half "
-          "in the far pole of the former bulb. Signed φ at the vertices (> 0: outside, late). "
-          "The poles lag as the spheroid's do (Meyer's operator where the curvature peaks); "
-          "the tips carry the pinch's own error.\n\n"
-          "| ξ | inner halves (tips): max φ, min φ | outer halves (poles): max φ, min φ | "
-          "paper L∞ |\n|---|---|---|---|\n";
-    for (const Json& r : db) {
-        const int pi = paper_index(r["xi_requested"].get<double>());
-        const Json& h = r["error_by_half"];
-        md << "| " << fmt(r["xi_requested"]) << " | " << max_min(h["inner"]) << " | "
-           << max_min(h["outer"]) << " | " << (pi >= 0 ? fmt(PAPER_A2_LINF[pi]) : "—") << " |\n";
-    }
-    md << "\n";
-    for (size_t i = 1; i < db.size(); ++i)
-        for (const char* half : {"inner", "outer"})
-            if (db[i - 1]["error_by_half"][half]["max"].get<double>() > 0.0 &&
-                db[i]["error_by_half"][half]["max"].get<double>() > 0.0)
-                md << "observed order (max φ, " << half << " halves, ξ "
-                   << fmt(db[i - 1]["xi_requested"]) << " → " << fmt(db[i]["xi_requested"])
-                   << "): **"
-                   << fmt(observed_order(db[i - 1]["error_by_half"][half]["max"].get<double>(),
-                                         db[i]["error_by_half"][half]["max"].get<double>(),
-                                         db[i - 1]["xi"].get<double>(), db[i]["xi"].get<double>()),
-                          "%.2f")
-                   << "**  \n";
-    const std::vector<Json> fitted =
-        select(results["runs"], "A2", std::string("dumbbell") + A2_QUARTIC_FIT_SUFFIX);
+          "and 16 sample points per triangle (`tracker::surface_error`).\n\n";
+    if (db.empty())
+        md << "Meyer's operator (the paper's) was left out by `--curvature-operator`.\n\n";
+    else
+        report_a2_cotangent_dumbbell(md, results, db);
     if (!fitted.empty()) {
         md << "\n### Dumbbell with the quartic-fit operator\n\n"
               "The same runs with `curvature_operator: quartic_fit` (not in the paper): each "
@@ -566,21 +577,23 @@ fig.savefig(os.path.join(out, "a1_error.png"), dpi=120)
 plt.close(fig)
 
 rs = sel("A2", "dumbbell")
-if rs:
+qs = sel("A2", "dumbbell, quartic fit")
+if rs or qs:
     fig, ax = plt.subplots(figsize=(6, 4.5))
-    xs = [r["xi"] for r in rs]
-    ax.loglog(xs, [r["error"]["linf"] for r in rs], "o-", label="L-inf vs axisymmetric reference")
-    ax.loglog(xs, [r["error"]["l1"] for r in rs], "o--", label="L1 vs axisymmetric reference")
-    ax.loglog(xs, [r["error"]["vertex_linf"] for r in rs], "d-",
-              label="vertex L-inf (the paper's samples)")
-    ax.loglog(xs, [r["error"]["vertex_l1"] for r in rs], "d--", label="vertex L1")
-    ax.loglog(xs, [r["reference_difference"]["linf"] for r in rs], "x:",
-              label="axisymmetric max |phi_coarse - phi_fine| (reference self-convergence)")
-    ax.loglog(xs, [r["openvdb_error"]["linf"] for r in rs], "s-", alpha=0.5,
-              label="L-inf vs OpenVDB 3-D reference")
-    ax.loglog(xs, [r["openvdb_reference_difference"]["linf"] for r in rs], "+:", alpha=0.5,
-              label="OpenVDB max |phi_coarse - phi_fine|")
-    qs = sel("A2", "dumbbell, quartic fit")
+    if rs:
+        xs = [r["xi"] for r in rs]
+        ax.loglog(xs, [r["error"]["linf"] for r in rs], "o-",
+                  label="L-inf vs axisymmetric reference")
+        ax.loglog(xs, [r["error"]["l1"] for r in rs], "o--", label="L1 vs axisymmetric reference")
+        ax.loglog(xs, [r["error"]["vertex_linf"] for r in rs], "d-",
+                  label="vertex L-inf (the paper's samples)")
+        ax.loglog(xs, [r["error"]["vertex_l1"] for r in rs], "d--", label="vertex L1")
+        ax.loglog(xs, [r["reference_difference"]["linf"] for r in rs], "x:",
+                  label="axisymmetric max |phi_coarse - phi_fine| (reference self-convergence)")
+        ax.loglog(xs, [r["openvdb_error"]["linf"] for r in rs], "s-", alpha=0.5,
+                  label="L-inf vs OpenVDB 3-D reference")
+        ax.loglog(xs, [r["openvdb_reference_difference"]["linf"] for r in rs], "+:", alpha=0.5,
+                  label="OpenVDB max |phi_coarse - phi_fine|")
     if qs:
         ax.loglog([r["xi"] for r in qs], [r["error"]["vertex_linf"] for r in qs], "P-",
                   label="vertex L-inf, quartic-fit operator")
