@@ -132,6 +132,7 @@ std::vector<Vec3> fitted_mean_curvature_normals(const SurfaceMesh& mesh, double 
     SurfaceFitOptions fit;
     fit.degree = QUARTIC_DEGREE;
     fit.through_origin = true;  // the vertex is on the surface; its curvature is wanted
+    fit.sphere_refit = true;    // no truncation error on spheres
     std::atomic<int> cotangent{0};
     tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_vertices(), FIT_GRAIN),
                       [&](const tbb::blocked_range<int>& range) {

@@ -58,14 +58,17 @@ enum class CurvatureOperator {
     /// 2.3e-3 too small at the poles and 1e-3 too large at the waist (6e-4 and 4e-4 at half ℓ),
     /// so an elongated drop rounds off too slowly.
     cotangent,
-    /// κ n of a quartic height field fitted over the vertex's two-ring
-    /// (fitted_mean_curvature_normals()), where that fit is accepted, else the cotangent K:
+    /// κ n of a quartic height field fitted through the vertex over its two-ring and refitted
+    /// as h = p + c·h² with c = −κ/4 (SurfaceFitOptions::sphere_refit;
+    /// fitted_mean_curvature_normals()), where that fit is accepted, else the cotangent K:
     /// pointwise convergent at about fourth order on smooth patches (the same spheroid with its
-    /// vertices on it: largest relative κ error 3.4e-3 at ℓ = 0.0128 and 3.4e-4 at 0.0064,
+    /// vertices on it: largest relative κ error 1.3e-3 at ℓ = 0.0128 and 1.2e-4 at 0.0064,
     /// where the cotangent K's is 9.6 % and 7.5 %). The tangential motion of the cotangent
     /// formula is dropped where the fit is used: the flow is normal, and remeshing keeps the
-    /// mesh. Its error is one-signed (κ too small, a fraction of order (ρκ)⁴ for a two-ring of
-    /// radius ρ), so on coarse meshes of strongly curved shapes the surface lags as a whole.
+    /// mesh. Without the refit the quartic's error is one-signed (κ too small, a fraction of
+    /// order (ρκ)⁴ for a two-ring of radius ρ: 3.4e-3 and 3.4e-4 on that spheroid), and on
+    /// the A2 dumbbell at ξ = 0.04, whose final drops are barely wider than a two-ring, every
+    /// drop lagged (vertex L1 2.8e-4, above the paper's 2.6e-4; with the refit 4.7e-5).
     quartic_fit,
 };
 
@@ -86,8 +89,9 @@ struct MeanCurvatureFlowOptions {
 
 /// Curvature normals K = κ n (1/m, the convention of the file comment) of the vertices at
 /// `positions` (one per vertex slot; nullptr: the mesh's own) with a quartic height field
-/// fitted over each vertex's two-ring (SurfaceFitOptions::degree 4, vertex_patch()): κ is the
-/// fit's mean curvature and n its normal at the vertex. Where the fit is refused, is not
+/// fitted through each vertex over its two-ring and refitted with the sphere's h² term
+/// (SurfaceFitOptions::degree 4, through_origin, sphere_refit; vertex_patch()): κ is the fit's
+/// mean curvature and n its normal at the vertex. Where the fit is refused, is not
 /// quartic (fewer than 15 vertices, rank-deficient) or turns by more than `max_turn` (radians),
 /// the cotangent K instead. Zero for dead, isolated and boundary vertices. `fallbacks`, when
 /// given, receives the number of live vertices that took the cotangent K. Throws

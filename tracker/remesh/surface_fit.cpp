@@ -161,6 +161,37 @@ void SurfaceFitOptions::validate() const {
         throw std::invalid_argument("degree: expected 2, 3 or 4, got " + std::to_string(degree));
 }
 
+namespace {
+
+/// h of h = p + c·h² for p = `p`: the root that tends to p as c → 0.
+double height_of(double p, double c) {
+    const double cp = c * p;
+    // 2p / (1 + sqrt(1 − 4cp)) is that root without cancellation; beyond the fold (1 − 4cp < 0)
+    // the surface has no point above, and the fold's height is the nearest.
+    return 2.0 * p / (1.0 + std::sqrt(std::max(0.0, 1.0 - 4.0 * cp)));
+}
+
+/// Height h, gradient and Hessian of h = p + c·h² at the frame origin from p's there:
+/// h_i = p_i / (1 − 2ch), h_ij = (p_ij + 2c h_i h_j) / (1 − 2ch).
+struct OriginJet {
+    double h, hs, ht, hss, hst, htt;
+};
+OriginJet origin_jet(const SurfacePatch& patch) {
+    const auto& c = patch.coefficients;
+    const double k = patch.height_squared;
+    OriginJet j;
+    j.h = height_of(c[0], k);
+    const double inv = 1.0 / (1.0 - 2.0 * k * j.h);
+    j.hs = c[1] * inv;
+    j.ht = c[2] * inv;
+    j.hss = (2.0 * c[3] + 2.0 * k * j.hs * j.hs) * inv;
+    j.hst = (c[4] + 2.0 * k * j.hs * j.ht) * inv;
+    j.htt = (2.0 * c[5] + 2.0 * k * j.ht * j.ht) * inv;
+    return j;
+}
+
+}  // namespace
+
 Vec3 SurfacePatch::point_above(const Vec3& x) const {
     const Vec3 r = x - origin;
     const double s = r.dot(u), t = r.dot(v);
@@ -170,24 +201,25 @@ Vec3 SurfacePatch::point_above(const Vec3& x) const {
                      c[6] * ss * s + c[7] * ss * t + c[8] * s * tt + c[9] * tt * t +
                      c[10] * ss * ss + c[11] * ss * s * t + c[12] * ss * tt + c[13] * s * tt * t +
                      c[14] * tt * tt;
-    return origin + s * u + t * v + h * normal;
+    return origin + s * u + t * v + height_of(h, height_squared) * normal;
 }
 
 double SurfacePatch::mean_curvature() const {
-    const auto& c = coefficients;
-    const double hs = c[1], ht = c[2], hss = 2.0 * c[3], hst = c[4], htt = 2.0 * c[5];
-    const double g = 1.0 + hs * hs + ht * ht;
-    return -((1.0 + ht * ht) * hss - 2.0 * hs * ht * hst + (1.0 + hs * hs) * htt) /
+    const OriginJet j = origin_jet(*this);
+    const double g = 1.0 + j.hs * j.hs + j.ht * j.ht;
+    return -((1.0 + j.ht * j.ht) * j.hss - 2.0 * j.hs * j.ht * j.hst + (1.0 + j.hs * j.hs) * j.htt) /
            (g * std::sqrt(g));
 }
 
 Vec3 SurfacePatch::surface_normal() const {
-    return (normal - coefficients[1] * u - coefficients[2] * v).normalized();
+    const OriginJet j = origin_jet(*this);
+    return (normal - j.hs * u - j.ht * v).normalized();
 }
 
 double SurfacePatch::turn() const {
     // Hessian [[a, b], [b, c]] of h at the origin.
-    const double a = 2.0 * coefficients[3], b = coefficients[4], c = 2.0 * coefficients[5];
+    const OriginJet j = origin_jet(*this);
+    const double a = j.hss, b = j.hst, c = j.htt;
     return radius * (0.5 * std::abs(a + c) + std::hypot(0.5 * (a - c), b));
 }
 
@@ -261,12 +293,30 @@ std::optional<SurfacePatch> fit_patch(const SurfaceMesh& mesh, const Positions& 
     if (!scaled)
         return std::nullopt;
     // Back from units of the patch radius: a term of degree k scales by inv^k.
-    static constexpr int TERM_DEGREE[QUARTIC_COEFFICIENTS] = {0, 1, 1, 2, 2, 2, 3, 3,
-                                                              3, 3, 4, 4, 4, 4, 4};
-    for (int k = 0; k < QUARTIC_COEFFICIENTS; ++k)
-        patch.coefficients[k] = (*scaled)[k] * std::pow(inv, TERM_DEGREE[k]);
-    if (!patch.coefficients.allFinite())
+    const auto unscale = [&patch, inv](const Coefficients& c) {
+        static constexpr int TERM_DEGREE[QUARTIC_COEFFICIENTS] = {0, 1, 1, 2, 2, 2, 3, 3,
+                                                                  3, 3, 4, 4, 4, 4, 4};
+        for (int k = 0; k < QUARTIC_COEFFICIENTS; ++k)
+            patch.coefficients[k] = c[k] * std::pow(inv, TERM_DEGREE[k]);
+        return patch.coefficients.allFinite();
+    };
+    if (!unscale(*scaled))
         return std::nullopt;
+    if (options.sphere_refit) {
+        const double c = -0.25 * patch.mean_curvature();
+        for (Eigen::Vector3d& l : local)
+            l.z() -= c * l.z() * l.z();
+        // The degree fitted first: the design is the same, only the heights changed.
+        const int degree = patch.degree;
+        scaled = degree == 4   ? solve(std::integral_constant<int, QUARTIC_COEFFICIENTS>{})
+                 : degree == 3 ? solve(std::integral_constant<int, CUBIC_COEFFICIENTS>{})
+                               : solve(std::integral_constant<int, QUADRATIC_COEFFICIENTS>{});
+        if (!scaled)
+            return std::nullopt;
+        patch.height_squared = c;
+        if (!unscale(*scaled))
+            return std::nullopt;
+    }
     return patch;
 }
 

@@ -65,6 +65,18 @@ struct SurfaceFitOptions {
     /// quartic's largest relative κ error falls from 6.6e-3 to 3.4e-3 (6.3e-4 to 3.4e-4 at
     /// half the edge length).
     bool through_origin = false;
+    /// Fit twice: the second time the surface h = p(s, t) + c·h² with c = −κ/4 from the first
+    /// fit's κ, the polynomial p to the heights' h − c·h² (same frame, same vertices).
+    /// A sphere of curvature κ (sum of the principal curvatures, the frame normal pointing out)
+    /// is exactly h = −(s² + t²)/(2R) − h²/(2R), i.e. c = −κ/4 with a quadratic p, so the refit
+    /// takes out the truncation error of the sphere's terms above the fitted degree, which
+    /// makes a quartic's κ one-signed: too small, by a fraction of order (ρκ)⁴ over a patch of
+    /// radius ρ. Largest relative κ error of a quartic through the vertex over its two-ring,
+    /// single fit → refit: sphere R = 0.1 at edge length 0.04 4.8e-2 → 2.3e-3, at 0.02
+    /// 2.7e-3 → 7.3e-6; spheroid (0.12, 0.076) at 0.0128 3.7e-3 → 1.3e-3, at 0.0064 3.8e-4 →
+    /// 1.3e-4. A free c would be one more unknown, nearly collinear with the quartic terms
+    /// (h² is quartic to leading order), whose noise we measured at ±1–5 % of κ.
+    bool sphere_refit = false;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
 
@@ -76,6 +88,9 @@ struct SurfacePatch {
     int degree = 2;       ///< degree actually fitted (≤ SurfaceFitOptions::degree)
     /// c₀ … c₁₄ of the file comment; the terms above `degree` are 0.
     Eigen::Matrix<double, 15, 1> coefficients = Eigen::Matrix<double, 15, 1>::Zero();
+    /// c of SurfaceFitOptions::sphere_refit (0 without): the surface is h = p + c·h², p the
+    /// polynomial of `coefficients`.
+    double height_squared = 0.0;
     /// The point of the fitted surface above (or below) x along the frame normal.
     Vec3 point_above(const Vec3& x) const;
     /// Mean curvature (sum of the principal curvatures, 1/m) of the fitted surface at its point
