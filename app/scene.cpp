@@ -221,11 +221,14 @@ void visit_fields(V& v, FlowOptions& o) {
         enum_field(r, "curvature_operator", o.mean_curvature.curvature_operator,
                    CURVATURE_OPERATORS,
                    "`cotangent` (Meyer et al., the paper's) or `quartic_fit` (κ n of a quartic "
-                   "height field fitted over each vertex's two-ring, pointwise fourth order on "
-                   "smooth patches; the cotangent formula where the fit turns by more than "
-                   "fit_max_turn)");
+                   "height field fitted through each vertex over its two-ring, pointwise fourth "
+                   "order on smooth patches; the cotangent formula where the fit turns by more "
+                   "than fit_max_turn)");
         r.number("fit_max_turn", o.mean_curvature.fit_max_turn, Range::positive(), "rad",
                  "quartic_fit: largest turn of the fitted two-ring for its curvature to be used");
+        r.boolean("fit_sphere_refit", o.mean_curvature.fit_sphere_refit,
+                  "quartic_fit: refit each quartic as h = p + c·h² with c = −κ/4 from the first "
+                  "fit, exact on spheres (false: the single fit, whose κ is slightly too small)");
     });
     v.section("curl_noise", "divergence-free pseudorandom field (type curl_noise)",
               [&](auto& r) { visit_fields(r, o.curl_noise); });

@@ -106,11 +106,13 @@ TEST(Scene, GeometricFlowKeys) {
     EXPECT_EQ(c.flow.curl_noise.octaves, tracker::CurlNoiseOptions{}.octaves);
     const Scene m = parse_scene(R"({"surface": {"shape": {"type": "sphere"}},
         "flow": {"type": "mean_curvature", "mean_curvature": {"integrator": "heun",
-                 "curvature_operator": "quartic_fit", "fit_max_turn": 0.5}}})",
+                 "curvature_operator": "quartic_fit", "fit_max_turn": 0.5,
+                 "fit_sphere_refit": false}}})",
                                 "t.json", ".");
     EXPECT_EQ(m.flow.mean_curvature.integrator, tracker::MeanCurvatureIntegrator::heun);
     EXPECT_EQ(m.flow.mean_curvature.curvature_operator, tracker::CurvatureOperator::quartic_fit);
     EXPECT_EQ(m.flow.mean_curvature.fit_max_turn, 0.5);
+    EXPECT_FALSE(m.flow.mean_curvature.fit_sphere_refit);
     EXPECT_EQ(parse_scene(R"({"surface": {"shape": {"type": "sphere"}}, "flow": {"type": "mean_curvature"}})",
                           "t.json", ".")
                   .flow.mean_curvature.curvature_operator,

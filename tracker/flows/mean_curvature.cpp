@@ -117,7 +117,7 @@ std::vector<double> mean_curvatures(const SurfaceMesh& mesh) {
 
 std::vector<Vec3> fitted_mean_curvature_normals(const SurfaceMesh& mesh, double max_turn,
                                                 const std::vector<Vec3>* positions,
-                                                int* fallbacks) {
+                                                int* fallbacks, bool sphere_refit) {
     if (!(max_turn > 0.0))
         throw std::invalid_argument("max_turn: expected a number > 0 (radians), got " +
                                     std::to_string(max_turn));
@@ -132,7 +132,7 @@ std::vector<Vec3> fitted_mean_curvature_normals(const SurfaceMesh& mesh, double 
     SurfaceFitOptions fit;
     fit.degree = QUARTIC_DEGREE;
     fit.through_origin = true;  // the vertex is on the surface; its curvature is wanted
-    fit.sphere_refit = true;    // no truncation error on spheres
+    fit.sphere_refit = sphere_refit;
     std::atomic<int> cotangent{0};
     tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_vertices(), FIT_GRAIN),
                       [&](const tbb::blocked_range<int>& range) {
@@ -187,7 +187,8 @@ std::vector<Vec3> mean_curvature_displacements(const SurfaceMesh& mesh, double d
     options.validate();
     if (options.curvature_operator == CurvatureOperator::cotangent)
         return mean_curvature_displacements(mesh, dt, options.integrator);
-    std::vector<Vec3> d = fitted_mean_curvature_normals(mesh, options.fit_max_turn);
+    std::vector<Vec3> d = fitted_mean_curvature_normals(mesh, options.fit_max_turn, nullptr,
+                                                        nullptr, options.fit_sphere_refit);
     for (Vec3& v : d)
         v *= -dt;
     if (options.integrator == MeanCurvatureIntegrator::forward_euler)
@@ -196,7 +197,8 @@ std::vector<Vec3> mean_curvature_displacements(const SurfaceMesh& mesh, double d
     for (int vi = 0; vi < mesh.num_vertices(); ++vi)
         if (mesh.vertex_alive(vi))
             predicted[static_cast<size_t>(vi)] = mesh.position(vi) + d[static_cast<size_t>(vi)];
-    const std::vector<Vec3> k = fitted_mean_curvature_normals(mesh, options.fit_max_turn, &predicted);
+    const std::vector<Vec3> k = fitted_mean_curvature_normals(
+        mesh, options.fit_max_turn, &predicted, nullptr, options.fit_sphere_refit);
     for (size_t i = 0; i < d.size(); ++i)
         d[i] = 0.5 * (d[i] - dt * k[i]);
     return d;

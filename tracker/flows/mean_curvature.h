@@ -84,21 +84,26 @@ struct MeanCurvatureFlowOptions {
     /// (SurfacePatch::turn(), radians, > 0): a thin neck or a just-pinched tip a few edges
     /// around is no height field, and the cotangent K takes over there.
     double fit_max_turn = 1.0;
+    /// quartic_fit: refit each quartic as h = p + c·h² with c = −κ/4 from the first fit
+    /// (SurfaceFitOptions::sphere_refit), which removes its truncation error on spheres
+    /// (one-signed, κ too small). false: the single fit.
+    bool fit_sphere_refit = true;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
 
 /// Curvature normals K = κ n (1/m, the convention of the file comment) of the vertices at
 /// `positions` (one per vertex slot; nullptr: the mesh's own) with a quartic height field
-/// fitted through each vertex over its two-ring and refitted with the sphere's h² term
-/// (SurfaceFitOptions::degree 4, through_origin, sphere_refit; vertex_patch()): κ is the fit's
-/// mean curvature and n its normal at the vertex. Where the fit is refused, is not
+/// fitted through each vertex over its two-ring and, with `sphere_refit`, refitted with the
+/// sphere's h² term (SurfaceFitOptions::degree 4, through_origin, sphere_refit;
+/// vertex_patch()): κ is the fit's mean curvature and n its normal at the vertex. Where the fit is refused, is not
 /// quartic (fewer than 15 vertices, rank-deficient) or turns by more than `max_turn` (radians),
 /// the cotangent K instead. Zero for dead, isolated and boundary vertices. `fallbacks`, when
 /// given, receives the number of live vertices that took the cotangent K. Throws
 /// std::invalid_argument on a wrongly sized `positions` or max_turn ≤ 0.
 std::vector<Vec3> fitted_mean_curvature_normals(const SurfaceMesh& mesh, double max_turn,
                                                 const std::vector<Vec3>* positions = nullptr,
-                                                int* fallbacks = nullptr);
+                                                int* fallbacks = nullptr,
+                                                bool sphere_refit = true);
 
 /// The CFL-limited forward-Euler step cfl_number · ℓ_min² (s, with unit diffusion coefficient:
 /// the flow speed is κ in m/s). Throws std::invalid_argument on invalid options or a mesh
