@@ -45,17 +45,25 @@ inline constexpr double MCF_MAX_DT = 1e-3;
 /// quarter of the step: 1.33e-3, at four times the steps).
 inline constexpr bool MCF_HEUN = true;
 /// A2 also runs the spheroid (quick and full) and the dumbbell (full; in quick too with
-/// A2_QUARTIC_FIT_DUMBBELL_IN_QUICK) with the quartic-fit curvature operator instead of
-/// Meyer's (tracker::CurvatureOperator::quartic_fit, not in the paper), labelled with this
-/// suffix; the rows with the paper's operator stay the primary ones. Spheroid without
-/// remeshing at ξ = 0.04 to t = 0.003: max |φ| 7.6e-5 against 2.3e-4. Dumbbell (vertex L∞, L1
-/// against the Δx = 0.000625 reference): ξ = 0.04 4.98e-4, 2.81e-4 (Meyer's 4.29e-4, 1.83e-4:
-/// the final drops, of radius ≈ 0.09, are barely wider than a two-ring there, and the fit's
-/// one-signed error leaves every drop outside, mean φ +2.8e-4); ξ = 0.02 5.87e-5, 2.22e-5
-/// (Meyer's 1.38e-4, 4.51e-5); ξ = 0.01 1.03e-5, 6.4e-6, every vertex inside by 2.6e-6 to
-/// 1.03e-5 (Meyer's 4.44e-5, 1.27e-5; the paper's 1.48e-5, 1.55e-5), measured on the scene
-/// a2_dumbbell_quartic_fit_xi0.01.json run with its steps cut at frame times (9133 steps,
-/// 112 min on 2 cores), not yet through `validate --full`.
+/// A2_QUARTIC_FIT_DUMBBELL_IN_QUICK or `--curvature-operator quartic_fit`) with the quartic-fit
+/// curvature operator instead of Meyer's (tracker::CurvatureOperator::quartic_fit, with its
+/// sphere refit, MeanCurvatureFlowOptions::fit_sphere_refit; not in the paper), labelled with
+/// this suffix; the rows with the paper's operator stay the primary ones. Dumbbell, vertex L∞
+/// and L1 against the Δx = 0.000625 reference at t = 0.025 (scene runs, the validate setup):
+///
+///   ξ      single quartic       with the sphere refit   Meyer's               paper
+///   0.04   4.98e-4  2.81e-4     1.91e-4  4.97e-5        4.29e-4  1.83e-4      6.18e-4  2.62e-4
+///   0.02   5.87e-5  2.22e-5     1.98e-4  1.38e-5        1.38e-4  4.51e-5      1.44e-4  7.03e-5
+///   0.01   1.03e-5  6.4e-6      (validate --full)        4.44e-5  1.27e-5      1.48e-5  1.55e-5
+///
+/// The single quartic's κ is too small by a fraction of order (ρκ)⁴ over a two-ring of radius
+/// ρ, and at ξ = 0.04, where a two-ring is as wide as a final drop, every drop lagged (mean φ
+/// +2.8e-4). The refit removes that, and the ξ = 0.02 L1 falls too; what it leaves at ξ = 0.02
+/// is the inner tips, 2e-4 ahead of the reference (mid and poles within 2.2e-5): the pinch
+/// comes early (quick run at ξ = 0.04: t = 0.0219193 against the reference's 0.021925; single
+/// quartic 0.0219275, Meyer 0.021948), and a drop's tip retracts at about κ ≈ 45 m/s at
+/// t = 0.025, so 1 µs of pinch time is 4.5e-5 m there. Spheroid without remeshing at ξ = 0.04
+/// to t = 0.003: max |φ| 7.6e-5 (single quartic) against Meyer's 2.3e-4.
 inline constexpr const char* A2_QUARTIC_FIT_SUFFIX = ", quartic fit";
 inline constexpr bool A2_QUARTIC_FIT_DUMBBELL_IN_QUICK = false;
 /// A2 collapses keep the new vertex at the butterfly point, on the smooth surface, instead of

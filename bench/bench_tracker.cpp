@@ -102,23 +102,27 @@ void BM_Integrate(benchmark::State& state) {
 }
 
 /// One evaluation of the curvature normals of every vertex: arg 0 Meyer's cotangent formula,
-/// 1 the quartic fit (mean_curvature.h, CurvatureOperator).
+/// 1 the quartic fit, 2 the quartic fit with its sphere refit (mean_curvature.h,
+/// CurvatureOperator, MeanCurvatureFlowOptions::fit_sphere_refit).
 void BM_CurvatureNormals(benchmark::State& state) {
     const SurfaceMesh& m = mesh_with(static_cast<int>(state.range(0)));
-    const bool fitted = state.range(1) == 1;
+    const int variant = static_cast<int>(state.range(1));
     for (auto _ : state) {
         const std::vector<Vec3> k =
-            fitted ? fitted_mean_curvature_normals(m, 1.0) : mean_curvature_normals(m);
+            variant > 0 ? fitted_mean_curvature_normals(m, 1.0, nullptr, nullptr, variant == 2)
+                        : mean_curvature_normals(m);
         benchmark::DoNotOptimize(k.data());
     }
-    state.SetLabel(fitted ? "quartic fit" : "cotangent");
+    state.SetLabel(variant == 0 ? "cotangent" : variant == 1 ? "quartic fit" : "quartic fit, refit");
     state.counters["triangles"] = m.num_triangles();
 }
 BENCHMARK(BM_CurvatureNormals)
     ->Args({10000, 0})
     ->Args({10000, 1})
+    ->Args({10000, 2})
     ->Args({50000, 0})
     ->Args({50000, 1})
+    ->Args({50000, 2})
     ->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_BroadPhaseSwept)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
