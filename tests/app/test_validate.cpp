@@ -377,28 +377,47 @@ TEST(ValidateOptionsCheck, NamesAnUnknownCurvatureOperator) {
     }
 }
 
-TEST(ValidateCurvatureOperatorSelection, QuarticFitAloneRunsOnlyItsRowsAndItsDumbbellInQuickMode) {
-    // Quick A2 with the quartic-fit operator only: its spheroid and (named, so also in quick
-    // mode) its dumbbell at ξ = 0.04; no sphere, no Meyer rows. Its dumbbell meets the paper's
-    // row there: vertex L∞, L1 1.78e-4, 4.7e-5 against the Δx = 0.000625 reference (paper
-    // 6.18e-4, 2.62e-4). Without the sphere refit the quartic's one-signed error left every
-    // drop outside: 4.98e-4, 2.81e-4, L1 above the paper's.
-    const fs::path out =
-        fs::temp_directory_path() /
-        ("meniscus_test_validate_operator_" + std::to_string(static_cast<long>(::getpid())));
+/// What a selective run_validation() wrote: results.json and report.md.
+struct ValidationOutput {
+    int exit_code = 0;
+    Json results;
+    std::string report;
+};
+
+/// Runs `options` (quietly) into a fresh temporary folder named after `tag`, reads back what it
+/// wrote and removes the folder.
+ValidationOutput run_into_temporary_folder(ValidateOptions options, const std::string& tag) {
+    const fs::path out = fs::temp_directory_path() /
+                         ("meniscus_test_validate_" + tag + "_" +
+                          std::to_string(static_cast<long>(::getpid())));
     fs::remove_all(out);
-    ValidateOptions options;
-    options.cases = {"A2"};
-    options.curvature_operators = {"quartic_fit"};
     options.out_dir = out.string();
     options.quiet = true;
-    EXPECT_EQ(run_validation(options), 0);
+    ValidationOutput o;
+    o.exit_code = run_validation(options);
     std::ifstream f(out / "results.json");
-    const Json results = Json::parse(f);
+    o.results = Json::parse(f);
     std::ifstream md(out / "report.md");
     std::stringstream report;
     report << md.rdbuf();
+    o.report = report.str();
     fs::remove_all(out);
+    return o;
+}
+
+TEST(ValidateCurvatureOperatorSelection, QuarticFitAloneRunsOnlyItsRowsAndItsDumbbellInQuickMode) {
+    // Quick A2 with the quartic-fit operator only: its spheroid and (named, so also in quick
+    // mode) its dumbbell at ξ = 0.04; no sphere, no Meyer rows. Its dumbbell meets the paper's
+    // row there: vertex L∞, L1 1.39e-4, 3.4e-5 against the quick reference (Δx = 0.0025) and
+    // 1.91e-4, 4.97e-5 against Δx = 0.000625 (paper 6.18e-4, 2.62e-4). Without the sphere
+    // refit the quartic's one-signed error left every drop outside: 4.98e-4, 2.81e-4, L1 above
+    // the paper's. Its pinch (measured 0.0219193) comes 5.7 µs before the reference's.
+    ValidateOptions options;
+    options.cases = {"A2"};
+    options.curvature_operators = {"quartic_fit"};
+    const ValidationOutput o = run_into_temporary_folder(options, "operator");
+    EXPECT_EQ(o.exit_code, 0);
+    const Json& results = o.results;
     std::vector<std::string> labels;
     for (const Json& r : results["runs"])
         labels.push_back(r["label"].get<std::string>());
@@ -411,27 +430,20 @@ TEST(ValidateCurvatureOperatorSelection, QuarticFitAloneRunsOnlyItsRowsAndItsDum
     EXPECT_GT(dumbbell["pinch_off_time"].get<double>(), A2_PINCH_AFTER);
     EXPECT_LT(dumbbell["pinch_off_time"].get<double>(), A2_PINCH_BEFORE);
     EXPECT_EQ(dumbbell["max_intersecting_pairs"].get<int>(), 0);
-    EXPECT_NE(report.str().find("### Dumbbell with the quartic-fit operator"), std::string::npos);
-    EXPECT_NE(report.str().find("left out by `--curvature-operator`"), std::string::npos);
+    EXPECT_NE(o.report.find("### Dumbbell with the quartic-fit operator"), std::string::npos);
+    EXPECT_NE(o.report.find("left out by `--curvature-operator`"), std::string::npos);
 }
 
 TEST(ValidateXiSelection, RunsOnlyTheRequestedResolution) {
     // Full A1 at ξ = 0.04 only: the two methods and the run without collision safety, none of
     // the 0.02 and 0.01 runs (those take minutes).
-    const fs::path out =
-        fs::temp_directory_path() /
-        ("meniscus_test_validate_xi_" + std::to_string(static_cast<long>(::getpid())));
-    fs::remove_all(out);
     ValidateOptions options;
     options.full = true;
     options.cases = {"A1"};
     options.xis = {0.04};
-    options.out_dir = out.string();
-    options.quiet = true;
-    EXPECT_EQ(run_validation(options), 0);
-    std::ifstream f(out / "results.json");
-    const Json results = Json::parse(f);
-    fs::remove_all(out);
+    const ValidationOutput o = run_into_temporary_folder(options, "xi");
+    EXPECT_EQ(o.exit_code, 0);
+    const Json& results = o.results;
     ASSERT_EQ(results["runs"].size(), 3u);
     for (const Json& r : results["runs"]) {
         EXPECT_EQ(r["case"], "A1");
