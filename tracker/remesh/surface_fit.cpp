@@ -60,14 +60,24 @@ void append_one_ring(const SurfaceMesh& mesh, int vi, std::vector<int>& out) {
             out.push_back(w);
 }
 
+/// A solved height field: scaled coefficients (zero-padded to 15) and the c of
+/// h = p + c·h² they were fitted with (SurfaceFitOptions::sphere_refit; 0: none).
+struct HeightField {
+    Coefficients scaled;
+    double height_squared = 0.0;
+};
+
 /// Least-squares height field with N coefficients (6: quadratic, 10: cubic, 15: quartic, in the
 /// order of the file comment) through `local` ((s, t, h) in the patch frame), in units of the
-/// patch radius: the scaled coefficients, zero-padded to 15, or nullopt where the design is
-/// rank-deficient or a vertex is further than `max_residual_fraction` of the radius from it.
-/// FIRST = 1 leaves c₀ out (it stays 0): the fit passes through the frame origin.
-template <int N, int FIRST>
-std::optional<Coefficients> solve_height_field(const std::vector<Eigen::Vector3d>& local,
-                                               double radius, double max_residual_fraction) {
+/// patch radius, or nullopt where the design is rank-deficient or a vertex is further than
+/// `max_residual_fraction` of the radius from it. FIRST = 1 leaves c₀ out (it stays 0): the fit
+/// passes through the frame origin. `refit`, given the first solution, returns the c with
+/// which to fit h − c·h² instead (SurfaceFitOptions::sphere_refit) or nullopt to keep it; the
+/// refit reuses the factorization, since only the heights change.
+template <int N, int FIRST, typename Refit>
+std::optional<HeightField> solve_height_field(const std::vector<Eigen::Vector3d>& local,
+                                              double radius, double max_residual_fraction,
+                                              const Refit& refit) {
     constexpr int M = N - FIRST;
     const double inv = 1.0 / radius;
     using Row = Eigen::Matrix<double, M, 1>;
@@ -95,15 +105,31 @@ std::optional<Coefficients> solve_height_field(const std::vector<Eigen::Vector3d
     if (ldlt.info() != Eigen::Success || !(pivots.maxCoeff() > 0.0) ||
         pivots.minCoeff() < RANK_TOLERANCE * RANK_TOLERANCE * pivots.maxCoeff())
         return std::nullopt;
-    const Row scaled = ldlt.solve(right);
-    double residual = 0.0;
-    for (const Eigen::Vector3d& l : local)
-        residual = std::max(residual, std::abs(design_row(l).dot(scaled) - l.z()));
-    if (!(residual <= max_residual_fraction * radius))
+    // Solves for the heights h − c·h² and checks the residuals.
+    const auto solve = [&](const Row& rhs, double c) -> std::optional<HeightField> {
+        const Row scaled = ldlt.solve(rhs);
+        double residual = 0.0;
+        for (const Eigen::Vector3d& l : local)
+            residual = std::max(residual,
+                                std::abs(design_row(l).dot(scaled) - (l.z() - c * l.z() * l.z())));
+        if (!(residual <= max_residual_fraction * radius))
+            return std::nullopt;
+        HeightField field;
+        field.scaled = Coefficients::Zero();
+        field.scaled.template segment<M>(FIRST) = scaled;
+        field.height_squared = c;
+        return field;
+    };
+    const std::optional<HeightField> first = solve(right, 0.0);
+    if (!first)
         return std::nullopt;
-    Coefficients padded = Coefficients::Zero();
-    padded.template segment<M>(FIRST) = scaled;
-    return padded;
+    const std::optional<double> c = refit(first->scaled);
+    if (!c)
+        return first;
+    Row refit_right = Row::Zero();
+    for (const Eigen::Vector3d& l : local)
+        refit_right += (l.z() - *c * l.z() * l.z()) * design_row(l);
+    return solve(refit_right, *c);
 }
 
 }  // namespace
@@ -267,31 +293,6 @@ std::optional<SurfacePatch> fit_patch(const SurfaceMesh& mesh, const Positions& 
     if (!(patch.radius > 0.0))
         return std::nullopt;
     const double inv = 1.0 / patch.radius;
-    // The highest degree asked for that the patch supports, falling back one degree at a time.
-    std::optional<Coefficients> scaled;
-    const auto solve = [&](auto coefficients) {
-        constexpr int n = decltype(coefficients)::value;
-        return options.through_origin
-                   ? solve_height_field<n, 1>(local, patch.radius, options.max_residual_fraction)
-                   : solve_height_field<n, 0>(local, patch.radius, options.max_residual_fraction);
-    };
-    const auto fits = [&](int degree, int coefficients) {
-        return !scaled && options.degree >= degree && ids.size() >= static_cast<size_t>(coefficients);
-    };
-    if (fits(4, QUARTIC_COEFFICIENTS)) {
-        scaled = solve(std::integral_constant<int, QUARTIC_COEFFICIENTS>{});
-        patch.degree = 4;
-    }
-    if (fits(3, CUBIC_COEFFICIENTS)) {
-        scaled = solve(std::integral_constant<int, CUBIC_COEFFICIENTS>{});
-        patch.degree = 3;
-    }
-    if (!scaled) {
-        scaled = solve(std::integral_constant<int, QUADRATIC_COEFFICIENTS>{});
-        patch.degree = 2;
-    }
-    if (!scaled)
-        return std::nullopt;
     // Back from units of the patch radius: a term of degree k scales by inv^k.
     const auto unscale = [&patch, inv](const Coefficients& c) {
         static constexpr int TERM_DEGREE[QUARTIC_COEFFICIENTS] = {0, 1, 1, 2, 2, 2, 3, 3,
@@ -300,23 +301,40 @@ std::optional<SurfacePatch> fit_patch(const SurfaceMesh& mesh, const Positions& 
             patch.coefficients[k] = c[k] * std::pow(inv, TERM_DEGREE[k]);
         return patch.coefficients.allFinite();
     };
-    if (!unscale(*scaled))
-        return std::nullopt;
-    if (options.sphere_refit) {
-        const double c = -0.25 * patch.mean_curvature();
-        for (Eigen::Vector3d& l : local)
-            l.z() -= c * l.z() * l.z();
-        // The degree fitted first: the design is the same, only the heights changed.
-        const int degree = patch.degree;
-        scaled = degree == 4   ? solve(std::integral_constant<int, QUARTIC_COEFFICIENTS>{})
-                 : degree == 3 ? solve(std::integral_constant<int, CUBIC_COEFFICIENTS>{})
-                               : solve(std::integral_constant<int, QUADRATIC_COEFFICIENTS>{});
-        if (!scaled)
+    // sphere_refit: c = −κ/4 of the first fit (SurfaceFitOptions::sphere_refit).
+    const auto refit = [&](const Coefficients& scaled) -> std::optional<double> {
+        if (!options.sphere_refit || !unscale(scaled))
             return std::nullopt;
-        patch.height_squared = c;
-        if (!unscale(*scaled))
-            return std::nullopt;
+        return -0.25 * patch.mean_curvature();
+    };
+    // The highest degree asked for that the patch supports, falling back one degree at a time.
+    std::optional<HeightField> field;
+    const auto solve = [&](auto coefficients) {
+        constexpr int n = decltype(coefficients)::value;
+        return options.through_origin
+                   ? solve_height_field<n, 1>(local, patch.radius, options.max_residual_fraction,
+                                              refit)
+                   : solve_height_field<n, 0>(local, patch.radius, options.max_residual_fraction,
+                                              refit);
+    };
+    const auto fits = [&](int degree, int coefficients) {
+        return !field && options.degree >= degree && ids.size() >= static_cast<size_t>(coefficients);
+    };
+    if (fits(4, QUARTIC_COEFFICIENTS)) {
+        field = solve(std::integral_constant<int, QUARTIC_COEFFICIENTS>{});
+        patch.degree = 4;
     }
+    if (fits(3, CUBIC_COEFFICIENTS)) {
+        field = solve(std::integral_constant<int, CUBIC_COEFFICIENTS>{});
+        patch.degree = 3;
+    }
+    if (!field) {
+        field = solve(std::integral_constant<int, QUADRATIC_COEFFICIENTS>{});
+        patch.degree = 2;
+    }
+    if (!field || !unscale(field->scaled))
+        return std::nullopt;
+    patch.height_squared = field->height_squared;
     return patch;
 }
 
