@@ -68,7 +68,7 @@ enum class CurvatureOperator {
     /// mesh. Without the refit the quartic's error is one-signed (κ too small, a fraction of
     /// order (ρκ)⁴ for a two-ring of radius ρ: 3.4e-3 and 3.4e-4 on that spheroid), and on
     /// the A2 dumbbell at ξ = 0.04, whose final drops are barely wider than a two-ring, every
-    /// drop lagged (vertex L1 2.8e-4, above the paper's 2.6e-4; with the refit 4.7e-5).
+    /// drop lagged (vertex L1 2.8e-4, above the paper's 2.6e-4; with the refit 5.0e-5).
     quartic_fit,
 };
 
@@ -95,11 +95,11 @@ struct MeanCurvatureFlowOptions {
 /// `positions` (one per vertex slot; nullptr: the mesh's own) with a quartic height field
 /// fitted through each vertex over its two-ring and, with `sphere_refit`, refitted with the
 /// sphere's h² term (SurfaceFitOptions::degree 4, through_origin, sphere_refit;
-/// vertex_patch()): κ is the fit's mean curvature and n its normal at the vertex. Where the fit is refused, is not
-/// quartic (fewer than 15 vertices, rank-deficient) or turns by more than `max_turn` (radians),
-/// the cotangent K instead. Zero for dead, isolated and boundary vertices. `fallbacks`, when
-/// given, receives the number of live vertices that took the cotangent K. Throws
-/// std::invalid_argument on a wrongly sized `positions` or max_turn ≤ 0.
+/// vertex_patch()): κ is the fit's mean curvature and n its normal at the vertex. Where the fit
+/// is refused, is not quartic (fewer than 15 vertices, rank-deficient) or turns by more than
+/// `max_turn` (radians), the cotangent K instead. Zero for dead, isolated and boundary vertices.
+/// `fallbacks`, when given, receives the number of live vertices that took the cotangent K.
+/// Throws std::invalid_argument on a wrongly sized `positions` or max_turn ≤ 0.
 std::vector<Vec3> fitted_mean_curvature_normals(const SurfaceMesh& mesh, double max_turn,
                                                 const std::vector<Vec3>* positions = nullptr,
                                                 int* fallbacks = nullptr,

@@ -301,7 +301,8 @@ std::optional<SurfacePatch> fit_patch(const SurfaceMesh& mesh, const Positions& 
             patch.coefficients[k] = c[k] * std::pow(inv, TERM_DEGREE[k]);
         return patch.coefficients.allFinite();
     };
-    // sphere_refit: c = −κ/4 of the first fit (SurfaceFitOptions::sphere_refit).
+    // sphere_refit: c = −κ/4 of the first fit (SurfaceFitOptions::sphere_refit); the patch's
+    // height_squared is still 0 here, so mean_curvature() is the first fit's.
     const auto refit = [&](const Coefficients& scaled) -> std::optional<double> {
         if (!options.sphere_refit || !unscale(scaled))
             return std::nullopt;
