@@ -53,16 +53,18 @@ inline constexpr bool MCF_HEUN = true;
 ///
 ///   ξ      single quartic       with the sphere refit   Meyer's               paper
 ///   0.04   4.98e-4  2.81e-4     1.91e-4  4.97e-5        4.29e-4  1.83e-4      6.18e-4  2.62e-4
-///   0.02   5.87e-5  2.22e-5     1.98e-4  1.38e-5        1.38e-4  4.51e-5      1.44e-4  7.03e-5
+///   0.02   5.87e-5  2.22e-5     2.25e-4  1.45e-5        1.38e-4  4.51e-5      1.44e-4  7.03e-5
 ///   0.01   1.03e-5  6.4e-6      (validate --full)        4.44e-5  1.27e-5      1.48e-5  1.55e-5
 ///
 /// The single quartic's κ is too small by a fraction of order (ρκ)⁴ over a two-ring of radius
 /// ρ, and at ξ = 0.04, where a two-ring is as wide as a final drop, every drop lagged (mean φ
 /// +2.8e-4). The refit removes that, and the ξ = 0.02 L1 falls too; what it leaves at ξ = 0.02
-/// is the inner tips, 2e-4 ahead of the reference (mid and poles within 2.2e-5): the pinch
-/// comes early (quick run at ξ = 0.04: t = 0.0219193 against the reference's 0.021925; single
-/// quartic 0.0219275, Meyer 0.021948), and a drop's tip retracts at about κ ≈ 45 m/s at
-/// t = 0.025, so 1 µs of pinch time is 4.5e-5 m there. Spheroid without remeshing at ξ = 0.04
+/// (validate --full; the ξ = 0.04 row is the scene run's) is the inner tips, 2.25e-4 ahead of the
+/// reference (poles within 1.4e-5): the pinch comes early (t = 0.0219234 at ξ = 0.02, 0.0219193
+/// in the quick ξ = 0.04 run, against the reference's 0.021925; single quartic 0.0219275 and
+/// Meyer 0.021948 at ξ = 0.04), which at the tips' final speed (κ ≈ 45 m/s) is 7e-5 of that
+/// lead at ξ = 0.02, and the tips retract slightly fast after it (0.21 m in 3 ms: 0.1 % is
+/// 2e-4). Spheroid without remeshing at ξ = 0.04
 /// to t = 0.003: max |φ| 7.6e-5 (single quartic) against Meyer's 2.3e-4.
 inline constexpr const char* A2_QUARTIC_FIT_SUFFIX = ", quartic fit";
 inline constexpr bool A2_QUARTIC_FIT_DUMBBELL_IN_QUICK = false;
