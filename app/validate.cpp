@@ -271,6 +271,8 @@ void case_a2(Context& c) {
     mcf_tracker.remesh.smoothing_fit_degree = MCF_SMOOTHING_FIT_DEGREE;
     mcf_tracker.remesh.smoothing_fit_max_turn = MCF_SMOOTHING_FIT_MAX_TURN;
     mcf_tracker.remesh.collapse_on_fitted_surface = MCF_COLLAPSE_ON_FITTED_SURFACE;
+    tracker::TrackerOptions quartic_fit_tracker = mcf_tracker;
+    quartic_fit_tracker.remesh.smoothing_fit_max_turn = MCF_QUARTIC_FIT_SMOOTHING_FIT_MAX_TURN;
     const auto mcf_run = [&](const std::string& label, double xi, tracker::ShapePtr shape,
                              const tracker::TrackerOptions& tracker, double t_end,
                              bool quartic_fit = false) {
@@ -409,7 +411,8 @@ void case_a2(Context& c) {
             runs.push_back(mcf_run("dumbbell", xi, dumbbell, mcf_tracker, DUMBBELL_END));
     if (c.runs_quartic_dumbbell())
         for (double xi : dumbbell_xis)
-            runs.push_back(mcf_run("dumbbell", xi, dumbbell, mcf_tracker, DUMBBELL_END, true));
+            runs.push_back(
+                mcf_run("dumbbell", xi, dumbbell, quartic_fit_tracker, DUMBBELL_END, true));
     const References refs = pending.get();
     const double widest = widest_section(refs.axis.back(), DUMBBELL_SEPARATION, 0.5 * axi_dx[1]);
     const double axi_trusted =
