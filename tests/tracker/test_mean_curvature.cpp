@@ -380,8 +380,8 @@ double inner_tip_apex(const SurfaceMesh& mesh, double reach) {
 /// t = 0.0240019 is AxisymmetricMcfReference's (Δx = 0.00125, within about 1.3e-5 of
 /// Δx = 0.000625 at t = 0.025).
 TEST(MeanCurvature, JustPinchedTipStaysWithTheReferenceWhenSmoothingFollowsTheFit) {
-    const std::string file =
-        std::string(MENISCUS_TEST_DATA_DIR) + "/regression/a2_dumbbell_quartic_xi0.02_t0.0230031.ply";
+    const std::string file = std::string(MENISCUS_TEST_DATA_DIR) +
+                             "/regression/a2_dumbbell_quartic_xi0.02_t0.0230031.ply";
     const SurfaceMesh start = to_surface_mesh(read_ply(file), file);
     const double duration = 0.0240019 - 0.0230031;
     const double reference_apex = 0.2050754;
