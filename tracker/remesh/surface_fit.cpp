@@ -284,6 +284,7 @@ std::optional<SurfacePatch> fit_patch(const SurfaceMesh& mesh, const Positions& 
     if (ids.size() < static_cast<size_t>(QUADRATIC_COEFFICIENTS))
         return std::nullopt;
 
+    patch.points = static_cast<int>(ids.size());
     std::vector<Eigen::Vector3d> local(ids.size());
     for (size_t i = 0; i < ids.size(); ++i) {
         const Vec3 r = position(ids[i]) - origin;

@@ -86,6 +86,7 @@ struct SurfacePatch {
     Vec3 u = Vec3::UnitX(), v = Vec3::UnitY(), normal = Vec3::UnitZ();  ///< orthonormal frame
     double radius = 0.0;  ///< largest |(s, t)| of the fitted vertices (m)
     int degree = 2;       ///< degree actually fitted (≤ SurfaceFitOptions::degree)
+    int points = 0;       ///< distinct vertices fitted (the frame origin's own included)
     /// c₀ … c₁₄ of the file comment; the terms above `degree` are 0.
     Eigen::Matrix<double, 15, 1> coefficients = Eigen::Matrix<double, 15, 1>::Zero();
     /// c of SurfaceFitOptions::sphere_refit (0 without): the surface is h = p + c·h², p the
