@@ -55,9 +55,13 @@ inline constexpr bool MCF_HEUN = true;
 ///
 ///   ξ     single quartic,  refit,           refit,           Meyer's,         paper
 ///         smoothing ≤ 0.6  smoothing ≤ 0.6  smoothing ≤ 1    smoothing ≤ 0.6
-///   0.04  4.98e-4 2.81e-4  1.91e-4 4.97e-5  2.56e-4 1.16e-4  4.29e-4 1.83e-4  6.18e-4 2.62e-4
-///   0.02  5.87e-5 2.22e-5  2.25e-4 1.45e-5  2.91e-5 7.3e-6   1.38e-4 4.51e-5  1.44e-4 7.03e-5
+///   0.04  4.98e-4 2.81e-4  1.91e-4 4.97e-5  2.32e-4 1.16e-4  4.29e-4 1.83e-4  6.18e-4 2.62e-4
+///   0.02  5.87e-5 2.22e-5  2.25e-4 1.45e-5  2.94e-5 7.2e-6   1.38e-4 4.51e-5  1.44e-4 7.03e-5
 ///   0.01  1.03e-5 6.4e-6   —                2.52e-5 9.0e-6   4.44e-5 1.27e-5  1.48e-5 1.55e-5
+///
+/// The third column's ξ = 0.04 and 0.02 rows were run after valence-4 vertices stopped using
+/// the interpolating quartic (fitted_mean_curvature_normals(); before: 2.56e-4 / 1.16e-4 and
+/// 2.91e-5 / 7.3e-6), its ξ = 0.01 row before.
 ///
 /// The single quartic's κ is too small by a fraction of order (ρκ)⁴ over a two-ring of radius
 /// ρ, and at ξ = 0.04, where a two-ring is as wide as a final drop, every drop lagged (mean φ
@@ -73,6 +77,20 @@ inline constexpr bool MCF_HEUN = true;
 /// Refitting the remeshing's fits the same way (not done) gave 1.75e-4 / 7.8e-5 at ξ = 0.04 but
 /// 8.1e-5 / 1.1e-5 at ξ = 0.02 (tips ahead again). Spheroid without remeshing at ξ = 0.04
 /// to t = 0.003: max |φ| 7.6e-5 (single quartic) against Meyer's 2.3e-4.
+///
+/// What keeps the refit's ξ = 0.01 L∞ above the paper's is the initial crease where the handle
+/// meets the balls (no blend: the surface turns by 0.84 rad there), not the operator. Against a
+/// Richardson-extrapolated reference (Δx 0.00125 and 0.0025; the Δx = 0.000625 one agrees within
+/// 7e-7 at t = 0.02), the ξ = 0.01 run's crease vertices are up to 3.5e-5 inside at t = 0.001
+/// (the mesh cannot follow the sqrt(t)-wide layer in which the crease rounds off); that deficit
+/// spreads along the handle (mean −4.7e-6 at t = 0.01; −1.1e-5 to −1.3e-5 along the neck at
+/// t = 0.0215), the thinner neck pinches early, and the just-pinched tips, retracting at about
+/// 47 m/s by t = 0.025, end 2.5e-5 ahead. At ξ = 0.02 the same run started from a mesh of the
+/// reference's own surface at t = 0.002 (no crease) has its neck +1.5e-6 on average at
+/// t = 0.01, against −6.0e-6 from t = 0. The neck lead barely shrinks from ξ = 0.02 to 0.01
+/// (t = 0.02: −9.6e-6, −7.9e-6), and refining the crease by curvature does not remove it: neck
+/// mean at t = 0.005, ξ = 0.02, with curvature_edge_fraction 0.7 / 0.5 / 0.35: −4.3e-6 /
+/// −5.9e-6 / +5.6e-6.
 inline constexpr const char* A2_QUARTIC_FIT_SUFFIX = ", quartic fit";
 inline constexpr bool A2_QUARTIC_FIT_DUMBBELL_IN_QUICK = false;
 /// A2 collapses keep the new vertex at the butterfly point, on the smooth surface, instead of
