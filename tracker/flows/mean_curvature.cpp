@@ -82,18 +82,15 @@ auto mesh_positions(const SurfaceMesh& mesh) {
 constexpr int FIT_GRAIN = 256;
 /// The quartic needs 15 coefficients: degree 4 of SurfaceFitOptions.
 constexpr int QUARTIC_DEGREE = 4;
-constexpr int CUBIC_DEGREE = 3;
-/// Fewest vertices (the centre's own included) for a fit through the centre to be used: more
-/// other vertices than unknowns (14 for the quartic, 9 for the cubic). A two-ring of exactly 14
-/// others (a valence-4 vertex) is interpolated by the quartic, and the interpolant's κ is so
-/// sensitive to the neighbours that the explicit step is unstable there: on the A2 dumbbell at
+/// A vertex whose two-ring has too few vertices for the quartic (fit_surface_patch() fits a
+/// degree only where more vertices than its unknowns constrain it: a valence-4 vertex has 14
+/// others for the quartic's 14) gets the cubic through it with the same refit. The quartic
+/// interpolating such a two-ring made the explicit step unstable: on the A2 dumbbell at
 /// ξ = 0.01 one such vertex had Σⱼ |∂κ/∂hⱼ| · Δt = 12.7 at the CFL step (every other vertex
 /// ≤ 1.02), and its height oscillated, growing 1.7 times per step, to 1.3e-4 off the surface.
-/// Such a vertex takes the cubic (with the same sphere refit) instead of the cotangent K, whose
-/// pointwise error at a valence-4 vertex is several percent (5.9 % on the spheroid of
-/// QuarticFitCurvatureConvergesPointwiseOnASpheroid).
-constexpr int QUARTIC_MIN_POINTS = 16;
-constexpr int CUBIC_MIN_POINTS = 11;
+/// The cotangent K there would err by several percent (5.9 % on the spheroid of
+/// QuarticFitCurvatureConvergesPointwiseOnASpheroid; the cubic 0.11 %).
+constexpr int CUBIC_DEGREE = 3;
 
 /// K = (1 / 2A) Σ (cot α + cot β)(xᵢ − xⱼ) per vertex from the accumulated sums.
 std::vector<Vec3> curvature_normals(const SurfaceMesh& mesh, const CotangentSums& sums) {
@@ -145,13 +142,6 @@ std::vector<Vec3> fitted_mean_curvature_normals(const SurfaceMesh& mesh, double 
     fit.degree = QUARTIC_DEGREE;
     fit.through_origin = true;  // the vertex is on the surface; its curvature is wanted
     fit.sphere_refit = sphere_refit;
-    SurfaceFitOptions cubic = fit;
-    cubic.degree = CUBIC_DEGREE;
-    // The quartic where more vertices than its unknowns fit it, else the cubic, else nothing.
-    const auto overdetermined = [](const std::optional<SurfacePatch>& patch) {
-        return patch && ((patch->degree == QUARTIC_DEGREE && patch->points >= QUARTIC_MIN_POINTS) ||
-                         (patch->degree == CUBIC_DEGREE && patch->points >= CUBIC_MIN_POINTS));
-    };
     std::atomic<int> cotangent{0};
     tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_vertices(), FIT_GRAIN),
                       [&](const tbb::blocked_range<int>& range) {
@@ -160,15 +150,11 @@ std::vector<Vec3> fitted_mean_curvature_normals(const SurfaceMesh& mesh, double 
                               if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty() ||
                                   mesh.is_boundary_vertex(vi))
                                   continue;
-                              const auto fit_with = [&](const SurfaceFitOptions& options) {
-                                  return positions ? vertex_patch(mesh, *positions, vi, options)
-                                                   : vertex_patch(mesh, vi, options);
-                              };
-                              std::optional<SurfacePatch> patch = fit_with(fit);
-                              if (patch && patch->degree == QUARTIC_DEGREE &&
-                                  !overdetermined(patch))
-                                  patch = fit_with(cubic);
-                              if (overdetermined(patch) && patch->turn() <= max_turn)
+                              const std::optional<SurfacePatch> patch =
+                                  positions ? vertex_patch(mesh, *positions, vi, fit)
+                                            : vertex_patch(mesh, vi, fit);
+                              if (patch && patch->degree >= CUBIC_DEGREE &&
+                                  patch->turn() <= max_turn)
                                   k[static_cast<size_t>(vi)] =
                                       patch->mean_curvature() * patch->surface_normal();
                               else

@@ -95,12 +95,11 @@ struct MeanCurvatureFlowOptions {
 /// `positions` (one per vertex slot; nullptr: the mesh's own) with a quartic height field
 /// fitted through each vertex over its two-ring and, with `sphere_refit`, refitted with the
 /// sphere's h² term (SurfaceFitOptions::degree 4, through_origin, sphere_refit;
-/// vertex_patch()): κ is the fit's mean curvature and n its normal at the vertex. Where the fit
-/// is refused, is not quartic (fewer than 15 vertices, rank-deficient) or turns by more than
-/// `max_turn` (radians), the cotangent K instead. A quartic fitted by only 14 vertices besides
-/// the centre (a valence-4 vertex) interpolates them, and its κ is too sensitive to them for the
-/// explicit step: such vertices take the cubic through the centre with the same refit (where
-/// 10 or more others fit it). Zero for dead, isolated and boundary vertices. `fallbacks`, when
+/// vertex_patch()): κ is the fit's mean curvature and n its normal at the vertex. A two-ring
+/// too small or degenerate for the quartic (it needs 15 vertices besides the centre, so a
+/// valence-4 vertex, with 14, is not interpolated) gets the cubic through the vertex with the
+/// same refit. Where neither is accepted, or the fit turns by more than `max_turn` (radians),
+/// the cotangent K instead. Zero for dead, isolated and boundary vertices. `fallbacks`, when
 /// given, receives the number of live vertices that took the cotangent K.
 /// Throws std::invalid_argument on a wrongly sized `positions` or max_turn ≤ 0.
 std::vector<Vec3> fitted_mean_curvature_normals(const SurfaceMesh& mesh, double max_turn,

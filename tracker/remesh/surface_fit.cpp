@@ -284,7 +284,6 @@ std::optional<SurfacePatch> fit_patch(const SurfaceMesh& mesh, const Positions& 
     if (ids.size() < static_cast<size_t>(QUADRATIC_COEFFICIENTS))
         return std::nullopt;
 
-    patch.points = static_cast<int>(ids.size());
     std::vector<Eigen::Vector3d> local(ids.size());
     for (size_t i = 0; i < ids.size(); ++i) {
         const Vec3 r = position(ids[i]) - origin;
@@ -319,8 +318,17 @@ std::optional<SurfacePatch> fit_patch(const SurfaceMesh& mesh, const Positions& 
                    : solve_height_field<n, 0>(local, patch.radius, options.max_residual_fraction,
                                               refit);
     };
+    // A degree is fitted only where more vertices than its unknowns constrain it: an
+    // interpolant has no residual to refuse a crease by, and its coefficients swing with every
+    // vertex (a quartic through a valence-4 vertex and its 14 neighbours moved its κ by up to
+    // 6e5 per metre a neighbour moved; see fitted_mean_curvature_normals()). Through the
+    // origin, a vertex at the origin constrains nothing.
+    const int fixed = options.through_origin ? 1 : 0;
+    int constraining = 0;
+    for (const Eigen::Vector3d& l : local)
+        constraining += fixed == 0 || l.x() != 0.0 || l.y() != 0.0;
     const auto fits = [&](int degree, int coefficients) {
-        return !field && options.degree >= degree && ids.size() >= static_cast<size_t>(coefficients);
+        return !field && options.degree >= degree && constraining > coefficients - fixed;
     };
     if (fits(4, QUARTIC_COEFFICIENTS)) {
         field = solve(std::integral_constant<int, QUARTIC_COEFFICIENTS>{});
@@ -330,7 +338,7 @@ std::optional<SurfacePatch> fit_patch(const SurfaceMesh& mesh, const Positions& 
         field = solve(std::integral_constant<int, CUBIC_COEFFICIENTS>{});
         patch.degree = 3;
     }
-    if (!field) {
+    if (fits(2, QUADRATIC_COEFFICIENTS)) {
         field = solve(std::integral_constant<int, QUADRATIC_COEFFICIENTS>{});
         patch.degree = 2;
     }

@@ -14,8 +14,8 @@
 /// splits).
 ///
 /// The fit is refused where the patch is not a graph over the frame (a triangle normal more
-/// than `max_normal_angle_degrees` from n), is too small or degenerate (fewer than 6 vertices, or
-/// a rank-deficient design matrix), does not fit (a residual above `max_residual_fraction` of the
+/// than `max_normal_angle_degrees` from n), is too small or degenerate (no more vertices than
+/// the quadratic has unknowns, or a rank-deficient design matrix), does not fit (a residual above `max_residual_fraction` of the
 /// patch size), or where the fitted point moves further than
 /// `max_offset_fraction` of the patch's size from the point it replaces: features (creases,
 /// corners) are left to the callers' sharp rules.
@@ -51,8 +51,11 @@ struct SurfaceFitOptions {
     /// moved by d along the fit then leaves the surface by that slope error times d, an error first
     /// order in d that does not average out when vertices keep drifting the same way (the A2
     /// dumbbell at ξ = 0.02 drifted 2.2e-4 outward with fitted smoothing). The cubic moves that
-    /// error to the quartic part. It needs 10 vertices; a patch with fewer, or a rank-deficient
-    /// cubic design, falls back to the quadratic. The quartic (15 vertices, else the cubic) also
+    /// error to the quartic part. A degree is fitted only where more vertices than its unknowns
+    /// constrain it (an interpolant has no residual to refuse a crease by, and swings with every
+    /// vertex): the cubic needs 11 vertices (10 besides the origin when through_origin); a
+    /// patch with fewer, or a rank-deficient cubic design, falls back to the quadratic (7, or 6
+    /// besides the origin). The quartic (16, or 15 besides the origin; else the cubic) also
     /// fits the quartic part of the surface, which quadratic and cubic fits take into their
     /// second derivatives: their curvature at the centre of a two-ring is off by a fraction of
     /// order (ρκ)² (+2.6 % to +4.4 % on a spheroid of semi-axes 0.12, 0.076 at edge length
@@ -86,7 +89,6 @@ struct SurfacePatch {
     Vec3 u = Vec3::UnitX(), v = Vec3::UnitY(), normal = Vec3::UnitZ();  ///< orthonormal frame
     double radius = 0.0;  ///< largest |(s, t)| of the fitted vertices (m)
     int degree = 2;       ///< degree actually fitted (≤ SurfaceFitOptions::degree)
-    int points = 0;       ///< distinct vertices fitted (the frame origin's own included)
     /// c₀ … c₁₄ of the file comment; the terms above `degree` are 0.
     Eigen::Matrix<double, 15, 1> coefficients = Eigen::Matrix<double, 15, 1>::Zero();
     /// c of SurfaceFitOptions::sphere_refit (0 without): the surface is h = p + c·h², p the
