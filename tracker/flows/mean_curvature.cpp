@@ -82,7 +82,7 @@ auto mesh_positions(const SurfaceMesh& mesh) {
 constexpr int FIT_GRAIN = 256;
 /// The quartic needs 15 coefficients: degree 4 of SurfaceFitOptions.
 constexpr int QUARTIC_DEGREE = 4;
-/// A vertex whose two-ring has too few vertices for the quartic (fit_surface_patch() fits a
+/// A vertex whose two-ring has too few vertices for the quartic (vertex_patch() fits a
 /// degree only where more vertices than its unknowns constrain it: a valence-4 vertex has 14
 /// others for the quartic's 14) gets the cubic through it with the same refit. The quartic
 /// interpolating such a two-ring made the explicit step unstable: on the A2 dumbbell at
