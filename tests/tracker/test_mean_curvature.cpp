@@ -1,5 +1,6 @@
 // Meyer et al. mean curvature and motion by mean curvature (paper §4.2).
 #include "tests/tracker/flow_test_meshes.h"
+#include "tests/tracker/mesh_rings.h"
 
 #include "tracker/flows/axisymmetric_mcf_reference.h"
 #include "tracker/flows/flow_runner.h"
@@ -230,19 +231,6 @@ SurfaceMesh ellipsoid_on_surface(const Vec3& radii, double h) {
         mesh.set_position(vi, x);
     }
     return mesh;
-}
-
-/// Distinct vertices of the triangles around vi's neighbours (vi included): the two-ring a
-/// vertex_patch() fits.
-int two_ring_size(const SurfaceMesh& mesh, int vi) {
-    std::vector<int> ring;
-    for (int ti : mesh.vertex_triangles(vi))
-        for (int w : mesh.triangle(ti))
-            for (int tj : mesh.vertex_triangles(w))
-                for (int x : mesh.triangle(tj))
-                    ring.push_back(x);
-    std::sort(ring.begin(), ring.end());
-    return static_cast<int>(std::unique(ring.begin(), ring.end()) - ring.begin());
 }
 
 /// Largest |κ − κ_exact| / κ_exact over the vertices of `k` (curvature normals) on an ellipsoid
@@ -483,7 +471,7 @@ TEST(MeanCurvature, QuarticFitStaysStableAtAValenceFourVertex) {
     flow.curvature_operator = CurvatureOperator::quartic_fit;
     const double dt = 2.639e-6;  // the run's step, 0.1 (shortest edge)²
     const int steps = 40;
-    const auto run = [&](SurfaceMesh mesh, int steps) {
+    const auto run = [&](SurfaceMesh mesh) {
         for (int s = 0; s < steps; ++s) {
             const std::vector<Vec3> d = mean_curvature_displacements(mesh, dt, flow);
             std::vector<Vec3> p = mesh.positions();
@@ -498,7 +486,7 @@ TEST(MeanCurvature, QuarticFitStaysStableAtAValenceFourVertex) {
     std::vector<Vec3> p = raised.positions();
     p[static_cast<size_t>(centre)] += 1e-6 * area_weighted_vertex_normals(raised)[static_cast<size_t>(centre)];
     raised.set_positions(p);
-    const SurfaceMesh a = run(start, steps), b = run(raised, steps);
+    const SurfaceMesh a = run(start), b = run(raised);
     double largest = 0.0;
     for (int v = 0; v < a.num_vertices(); ++v)
         largest = std::max(largest, (a.position(v) - b.position(v)).norm());

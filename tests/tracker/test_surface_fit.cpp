@@ -3,6 +3,7 @@
 /// inside on average) and tangent-plane smoothing moves sank A1's growing spheres by 6e-4 over
 /// t ∈ [0, 1] at ξ = 0.04.
 
+#include "mesh_rings.h"
 #include "remesh_test_meshes.h"
 
 #include "tracker/implicit_mesher.h"
@@ -279,16 +280,6 @@ TEST(SurfaceFit, SphereRefitSquaresTheQuarticsCurvatureErrorOnASphere) {
     // A vertex whose two-ring has fewer than 15 others (valence 4) would be interpolated by
     // the quartic: it gets the cubic, and is left out here.
     const SurfaceMesh mesh = sphere_mesh(0.06);
-    const auto two_ring_others = [&mesh](int vi) {
-        std::vector<int> ring;
-        for (int ti : mesh.vertex_triangles(vi))
-            for (int w : mesh.triangle(ti))
-                for (int tj : mesh.vertex_triangles(w))
-                    for (int x : mesh.triangle(tj))
-                        ring.push_back(x);
-        std::sort(ring.begin(), ring.end());
-        return static_cast<int>(std::unique(ring.begin(), ring.end()) - ring.begin()) - 1;
-    };
     double first = 0.0, refit = 0.0, first_residual = 0.0, refit_residual = 0.0;
     int short_rings = 0;
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
@@ -299,7 +290,7 @@ TEST(SurfaceFit, SphereRefitSquaresTheQuarticsCurvatureErrorOnASphere) {
         options.sphere_refit = true;
         const std::optional<SurfacePatch> twice = vertex_patch(mesh, vi, options);
         ASSERT_TRUE(single && twice);
-        if (two_ring_others(vi) < 15) {
+        if (testing::two_ring_size(mesh, vi) < 16) {  // the vertex and fewer than 15 others
             EXPECT_EQ(twice->degree, 3);
             ++short_rings;
             continue;
