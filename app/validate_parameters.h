@@ -91,6 +91,28 @@ inline constexpr bool MCF_HEUN = true;
 /// (t = 0.02: −9.6e-6, −7.9e-6), and refining the crease by curvature does not remove it: neck
 /// mean at t = 0.005, ξ = 0.02, with curvature_edge_fraction 0.7 / 0.5 / 0.35: −4.3e-6 /
 /// −5.9e-6 / +5.6e-6.
+///
+/// How the crease is sampled decides the sign (neck |x| < 0.2 mean / crease 0.2 < |x| < 0.36
+/// mean, t = 0.005, ξ = 0.02, against the Richardson reference; none of this is in the A2 setup):
+///
+///   setup                                                        neck      crease    steps
+///   as validated (curvature_edge_fraction c = 0.7)               −4.3e-6   −1.2e-5     282
+///   c = 0.7, min_curvature_size_fraction 0.125                   −4.3e-6   −1.2e-5     282
+///   Meyer's K wherever the fit turns > 0.5 rad (at the crease)   −1.0e-5   −3.0e-5     282
+///   c = 0.35 (the crease refined by splits on fitted surfaces)   +5.6e-6   +1.3e-5     536
+///   c = 0.35, min_curvature_size_fraction 0.125                  +4.0e-6   +9.0e-6     573
+///   c = 0.35, initial mesh split twice within 2ξ of each crease,
+///     new vertices on the exact dumbbell                         +1.7e-6   +4.4e-6    1555
+///   reference's own surface at t = 0.002 (no crease), t = 0.006   +7.8e-7   +7.1e-7     224
+///
+/// At c = 0.7 the crease is never refined (vertex normals spread its 0.84 rad over two edges,
+/// each under 0.7), so lowering the floor changes nothing. Unrefined, the crease vertices lag
+/// while the rounding layer is narrower than an edge; refined by the tracker, each split vertex
+/// lands on a fitted surface that rounds the concave corner and overfills it; refined at the
+/// start with vertices on the exact surface, the run comes closest to the crease-free one. The
+/// pinch itself is not the lead: lowering the size floor to 0.125 halves the radius at which
+/// the neck separates and leaves ξ = 0.02 at vertex L∞ / L1 2.52e-5 / 7.10e-6 against the
+/// Richardson reference (2.47e-5 / 7.30e-6 with 0.25).
 inline constexpr const char* A2_QUARTIC_FIT_SUFFIX = ", quartic fit";
 inline constexpr bool A2_QUARTIC_FIT_DUMBBELL_IN_QUICK = false;
 /// A2 collapses keep the new vertex at the butterfly point, on the smooth surface, instead of
