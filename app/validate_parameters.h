@@ -57,11 +57,11 @@ inline constexpr bool MCF_HEUN = true;
 ///         smoothing ≤ 0.6  smoothing ≤ 0.6  smoothing ≤ 1    smoothing ≤ 0.6
 ///   0.04  4.98e-4 2.81e-4  1.91e-4 4.97e-5  2.32e-4 1.16e-4  4.29e-4 1.83e-4  6.18e-4 2.62e-4
 ///   0.02  5.87e-5 2.22e-5  2.25e-4 1.45e-5  2.94e-5 7.2e-6   1.38e-4 4.51e-5  1.44e-4 7.03e-5
-///   0.01  1.03e-5 6.4e-6   —                2.52e-5 9.0e-6   4.44e-5 1.27e-5  1.48e-5 1.55e-5
+///   0.01  1.03e-5 6.4e-6   —                2.59e-5 9.46e-6  4.44e-5 1.27e-5  1.48e-5 1.55e-5
 ///
 /// The third column's ξ = 0.04 and 0.02 rows were run after valence-4 vertices stopped using
 /// the interpolating quartic (fitted_mean_curvature_normals(); before: 2.56e-4 / 1.16e-4 and
-/// 2.91e-5 / 7.3e-6), its ξ = 0.01 row before.
+/// 2.91e-5 / 7.3e-6); its ξ = 0.01 row too (before: 2.52e-5 / 9.0e-6), 9134 steps, pinch in frame 44.
 ///
 /// The single quartic's κ is too small by a fraction of order (ρκ)⁴ over a two-ring of radius
 /// ρ, and at ξ = 0.04, where a two-ring is as wide as a final drop, every drop lagged (mean φ
