@@ -15,10 +15,10 @@
 ///
 /// The fit is refused where the patch is not a graph over the frame (a triangle normal more
 /// than `max_normal_angle_degrees` from n), is too small or degenerate (no more vertices than
-/// the quadratic has unknowns, or a rank-deficient design matrix), does not fit (a residual above `max_residual_fraction` of the
-/// patch size), or where the fitted point moves further than
-/// `max_offset_fraction` of the patch's size from the point it replaces: features (creases,
-/// corners) are left to the callers' sharp rules.
+/// the quadratic has unknowns, or a rank-deficient design matrix), does not fit (a residual
+/// above `max_residual_fraction` of the patch size), or where the fitted point moves further
+/// than `max_offset_fraction` of the patch's size from the point it replaces: features
+/// (creases, corners) are left to the callers' sharp rules.
 
 #include "tracker/mesh.h"
 #include "tracker/quadric.h"
