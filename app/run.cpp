@@ -297,6 +297,7 @@ static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::strin
         tracker::ImplicitMeshOptions options;
         options.edge_length = scene.surface.edge_length;
         options.remesh_iterations = scene.surface.remesh_iterations;
+        options.crease = scene.surface.crease;
         tracker::ImplicitMeshReport r;
         SurfaceMesh mesh;
         try {
@@ -313,6 +314,9 @@ static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::strin
               << " triangles, mean edge " << r.mean_edge_length << " m (requested "
               << scene.surface.edge_length << "), angles " << r.min_angle_degrees << "°–"
               << r.max_angle_degrees << "°";
+            if (r.crease_splits > 0)
+                s << ", " << r.crease_splits << " crease refinement splits around "
+                  << r.crease_vertices << " crease vertices";
             *report = s.str();
         }
         return mesh;

@@ -124,6 +124,14 @@ void visit_fields(V& v, SurfaceOptions& o) {
            "closed, consistently oriented, no degenerate or duplicate triangles");
     v.integer("remesh_iterations", o.remesh_iterations, Range::between(0, 100), "",
               "isotropic remeshing passes after marching tetrahedra");
+    v.section("crease", "refinement around the shape's creases after meshing", [&](auto& r) {
+        r.integer("levels", o.crease.levels, Range::between(0, 4), "",
+                  "edge halvings near creases (0 = off)");
+        r.number("angle", o.crease.angle, Range{0.0, M_PI, true, true}, "rad",
+                 "an edge whose end normals turn by more than this crosses a crease");
+        r.number("band", o.crease.band, Range::non_negative(), "m",
+                 "refine within this distance of a crease (0 = twice edge_length)");
+    });
     v.boolean("open", o.open,
               "the mesh_file is an open surface with boundary edges (paper §4.4; geometric flows "
               "only): boundary edges are never split, flipped, collapsed or merged");
@@ -541,6 +549,9 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
             throw SceneError("/time/land_on_frames: fluid scenes always land on frame times");
         if (scene.surface.open && scene.shape)
             throw SceneError("/surface/open: only a mesh_file can be open (shapes are closed)");
+        if (scene.surface.crease.levels > 0 && !scene.shape)
+            throw SceneError("/surface/crease/levels: crease refinement needs a `shape` (it "
+                             "moves new vertices onto the exact surface)");
         if (scene.surface.open && scene.flow.type == "fluid")
             throw SceneError("/surface/open: fluid scenes need a closed surface");
         if (!scene.surface.mesh_file.empty() && scene.surface.mesh_file.front() != '/' &&

@@ -8,6 +8,7 @@
 #include "tracker/flows/face_offsetting.h"
 #include "tracker/flows/flow_errors.h"
 #include "tracker/flows/mean_curvature.h"
+#include "tracker/implicit_mesher.h"
 #include "tracker/implicit_shape.h"
 #include "tracker/surface_tracker.h"
 
@@ -22,6 +23,7 @@ struct SurfaceOptions {
     double edge_length = 0.02;  ///< requested mean edge length ξ of the generated mesh (m)
     std::string mesh_file;      ///< OBJ/PLY path, relative to the scene file (instead of shape)
     int remesh_iterations = 8;  ///< isotropic remeshing passes when meshing a shape
+    tracker::CreaseRefinementOptions crease;  ///< refinement around the shape's creases
     /// Which phase the shape encloses: "liquid" (drops, pools: region labels {1, 0}) or "gas"
     /// (bubbles in a liquid that fills the rest: labels {0, 1}).
     std::string inside = "liquid";

@@ -104,6 +104,9 @@ inline constexpr bool MCF_HEUN = true;
 ///   c = 0.35, initial mesh split twice within 2ξ of each crease,
 ///     new vertices on the exact dumbbell                         +1.7e-6   +4.4e-6    1555
 ///   reference's own surface at t = 0.002 (no crease), t = 0.006   +7.8e-7   +7.1e-7     224
+///   c = 0.7, initial mesh split once within 2ξ of each crease
+///     (surface/crease levels 1: CreaseRefinementOptions)        +8.1e-7   −2.3e-7     596
+///   ξ = 0.01 as validated, for scale                              −2.4e-6   −7.0e-6    1149
 ///
 /// At c = 0.7 the crease is never refined (vertex normals spread its 0.84 rad over two edges,
 /// each under 0.7), so lowering the floor changes nothing. Unrefined, the crease vertices lag

@@ -26,6 +26,11 @@ constexpr int PADDING_CELLS = 2;
 /// Keep crossings this fraction of a grid edge away from grid nodes (no zero-length edges).
 constexpr double MIN_CROSSING_PARAMETER = 1e-3;
 
+/// Crease refinement halves edges at most this many times (16× finer than edge_length).
+constexpr int MAX_CREASE_LEVELS = 4;
+/// Crease band relative to edge_length when CreaseRefinementOptions::band is 0.
+constexpr double DEFAULT_CREASE_BAND_EDGES = 2.0;
+
 /// Cube corner offsets indexed by bits (x = bit 0, y = bit 1, z = bit 2).
 constexpr std::array<std::array<int, 3>, 8> CORNER = {
     {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}}};
@@ -170,6 +175,104 @@ private:
     std::unordered_map<std::uint64_t, int> m_edge_vertex;
 };
 
+Vec3 unit_normal(const ImplicitShape& shape, const Vec3& x) {
+    const Vec3 g = shape.gradient(x);
+    const double n = g.norm();
+    return n > 0.0 ? Vec3(g / n) : Vec3::Zero();
+}
+
+/// Midpoints of the edges whose end normals turn by more than `angle`: points within half an
+/// edge of the shape's creases.
+std::vector<Vec3> crease_points(const SurfaceMesh& mesh, const ImplicitShape& shape,
+                                double angle, int* crease_vertices) {
+    std::vector<Vec3> normal(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        if (mesh.vertex_alive(vi))
+            normal[static_cast<size_t>(vi)] = unit_normal(shape, mesh.position(vi));
+    const double min_cos = std::cos(angle);
+    std::vector<Vec3> points;
+    std::vector<std::uint8_t> marked(normal.size(), 0);
+    for (int ei = 0; ei < mesh.num_edges(); ++ei) {
+        if (!mesh.edge_alive(ei))
+            continue;
+        const auto& e = mesh.edge(ei);
+        if (normal[static_cast<size_t>(e[0])].dot(normal[static_cast<size_t>(e[1])]) >= min_cos)
+            continue;
+        points.push_back(0.5 * (mesh.position(e[0]) + mesh.position(e[1])));
+        marked[static_cast<size_t>(e[0])] = marked[static_cast<size_t>(e[1])] = 1;
+    }
+    if (crease_vertices)
+        *crease_vertices = static_cast<int>(std::count(marked.begin(), marked.end(), 1));
+    return points;
+}
+
+/// Points bucketed on a grid of cell size `radius`, for "is any point within radius" queries.
+class PointGrid {
+public:
+    PointGrid(const std::vector<Vec3>& points, double radius) : m_points(points), m_r(radius) {
+        for (size_t i = 0; i < points.size(); ++i)
+            m_cells[key(cell(points[i]))].push_back(static_cast<int>(i));
+    }
+    bool any_within(const Vec3& x) const {
+        const std::array<long, 3> c = cell(x);
+        for (long dx = -1; dx <= 1; ++dx)
+            for (long dy = -1; dy <= 1; ++dy)
+                for (long dz = -1; dz <= 1; ++dz) {
+                    const auto it = m_cells.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
+                    if (it == m_cells.end())
+                        continue;
+                    for (int i : it->second)
+                        if ((m_points[static_cast<size_t>(i)] - x).squaredNorm() <= m_r * m_r)
+                            return true;
+                }
+        return false;
+    }
+
+private:
+    std::array<long, 3> cell(const Vec3& x) const {
+        return {static_cast<long>(std::floor(x.x() / m_r)),
+                static_cast<long>(std::floor(x.y() / m_r)),
+                static_cast<long>(std::floor(x.z() / m_r))};
+    }
+    static std::uint64_t key(const std::array<long, 3>& c) {
+        const auto part = [](long v) { return static_cast<std::uint64_t>(v) & 0x1fffffu; };
+        return part(c[0]) | (part(c[1]) << 21) | (part(c[2]) << 42);
+    }
+    const std::vector<Vec3>& m_points;
+    double m_r;
+    std::unordered_map<std::uint64_t, std::vector<int>> m_cells;
+};
+
+/// ImplicitMeshOptions' crease refinement; returns the edges split.
+int refine_creases(SurfaceMesh& mesh, const ImplicitShape& shape,
+                   const ImplicitMeshOptions& options, int* crease_vertices) {
+    const CreaseRefinementOptions& crease = options.crease;
+    const double band =
+        crease.band > 0.0 ? crease.band : DEFAULT_CREASE_BAND_EDGES * options.edge_length;
+    int splits = 0;
+    for (int pass = 0; pass < crease.levels; ++pass) {
+        const std::vector<Vec3> points = crease_points(mesh, shape, crease.angle,
+                                                       pass == 0 ? crease_vertices : nullptr);
+        if (points.empty())
+            break;
+        const PointGrid grid(points, band);
+        const double min_length = options.edge_length * std::ldexp(1.0, -(pass + 1));
+        const int edges = mesh.num_edges();  // edges made by this pass wait for the next
+        for (int ei = 0; ei < edges; ++ei) {
+            if (!mesh.edge_alive(ei))
+                continue;
+            const auto& e = mesh.edge(ei);
+            const Vec3 a = mesh.position(e[0]), b = mesh.position(e[1]);
+            const Vec3 mid = 0.5 * (a + b);
+            if ((a - b).norm() <= min_length || !grid.any_within(mid))
+                continue;
+            mesh.split_edge(ei, project_to_zero_set(shape, mid, options.projection_iterations));
+            ++splits;
+        }
+    }
+    return splits;
+}
+
 }  // namespace
 
 void ImplicitMeshOptions::validate() const {
@@ -179,6 +282,17 @@ void ImplicitMeshOptions::validate() const {
         throw std::invalid_argument("remesh_iterations: expected an integer >= 0");
     if (projection_iterations < 0)
         throw std::invalid_argument("projection_iterations: expected an integer >= 0");
+    crease.validate();
+}
+
+void CreaseRefinementOptions::validate() const {
+    if (levels < 0 || levels > MAX_CREASE_LEVELS)
+        throw std::invalid_argument("crease.levels: expected an integer in [0, " +
+                                    std::to_string(MAX_CREASE_LEVELS) + "]");
+    if (!(angle > 0.0 && angle < M_PI))
+        throw std::invalid_argument("crease.angle: expected radians in (0, pi)");
+    if (!(band >= 0.0) || !std::isfinite(band))
+        throw std::invalid_argument("crease.band: expected a number >= 0");
 }
 
 Vec3 project_to_zero_set(const ImplicitShape& shape, const Vec3& x, int iterations) {
@@ -212,7 +326,11 @@ SurfaceMesh mesh_implicit_shape(const ImplicitShape& shape, const ImplicitMeshOp
     isotropic_remesh(mesh, remesh, [&shape, newton](const Vec3& p) {
         return project_to_zero_set(shape, p, newton);
     });
+    int crease_vertices = 0;
+    const int crease_splits = refine_creases(mesh, shape, options, &crease_vertices);
     if (report) {
+        report->crease_vertices = crease_vertices;
+        report->crease_splits = crease_splits;
         report->vertices = mesh.count_live_vertices();
         report->triangles = mesh.count_live_triangles();
         report->mean_edge_length = edge_length_stats(mesh).mean;

@@ -42,6 +42,24 @@ TEST(Scene, DefaultsComeFromTheStructs) {
     EXPECT_DOUBLE_EQ(s.shape->value({0, 0, 0}), -0.2);  // default sphere radius 0.2
 }
 
+TEST(Scene, SurfaceCreaseRefinementIsReadAndChecked) {
+    const Scene s = parse_scene(
+        R"({"surface": {"shape": {"type": "sphere"}, "crease": {"levels": 2, "angle": 0.5}}})",
+        "t.json", ".");
+    EXPECT_EQ(s.surface.crease.levels, 2);
+    EXPECT_DOUBLE_EQ(s.surface.crease.angle, 0.5);
+    EXPECT_DOUBLE_EQ(s.surface.crease.band, tracker::CreaseRefinementOptions{}.band);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}, "crease": {"level": 1}}})")
+                  .find("/surface/crease/level: unknown key"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}, "crease": {"levels": 9}}})")
+                  .find("/surface/crease/levels"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"mesh_file": "m.obj", "crease": {"levels": 1}}})")
+                  .find("/surface/crease/levels: crease refinement needs a `shape`"),
+              std::string::npos);
+}
+
 TEST(Scene, ErrorsNameTheJsonPath) {
     EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "fluids": {}})")
                   .find("test.json: /fluids: unknown key"),

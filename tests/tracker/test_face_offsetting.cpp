@@ -74,10 +74,12 @@ TEST(FaceOffsetting, FirstStepOfTwoSphereTestAgreesWithExactSolution) {
     const TwoSphereNormalFlow flow;  // VALIDATION.md A1
     const double dt = 0.005;
     for (double edge : {0.04, 0.02}) {
+        ImplicitMeshOptions mesh_options;
+        mesh_options.edge_length = edge;
         SurfaceMesh mesh =
             mesh_implicit_shape(*make_union({make_sphere(flow.center0, flow.initial_radius),
                                              make_sphere(flow.center1, flow.initial_radius)}),
-                                ImplicitMeshOptions{edge});
+                                mesh_options);
         for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
             const Vec3& p = mesh.position(vi);
             const Vec3& c = p.x() < 0.0 ? flow.center0 : flow.center1;

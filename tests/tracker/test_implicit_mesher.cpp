@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace meniscus::tracker {
 namespace {
@@ -79,6 +81,91 @@ TEST(ImplicitMesher, RejectsNonPositiveEdgeLength) {
     ImplicitMeshOptions options;
     options.edge_length = 0.0;
     EXPECT_THROW(mesh_implicit_shape(*make_sphere({0, 0, 0}, 1.0), options), std::invalid_argument);
+}
+
+/// |x| of the A2 dumbbell's creases (balls of 0.3 at ±0.5, handle of radius 0.2).
+const double A2_CREASE_X = 0.5 - std::sqrt(0.3 * 0.3 - 0.2 * 0.2);
+
+TEST(ImplicitMesher, CreaseRefinementHalvesEdgesNearTheCreaseOnlyWithVerticesOnTheShape) {
+    const ShapePtr dumbbell = make_dumbbell({0, 0, 0}, 0.3, 1.0, 0.2, 0.0);
+    const double xi = 0.04;
+    ImplicitMeshOptions options;
+    options.edge_length = xi;
+    const SurfaceMesh plain = mesh_implicit_shape(*dumbbell, options);
+    options.crease.levels = 1;
+    ImplicitMeshReport report;
+    const SurfaceMesh refined = mesh_implicit_shape(*dumbbell, options, &report);
+
+    EXPECT_GT(report.crease_vertices, 0);
+    EXPECT_GT(report.crease_splits, 0);
+    EXPECT_TRUE(validate_mesh(refined).empty());
+    EXPECT_TRUE(find_self_intersections(refined).intersection_free());
+    EXPECT_EQ(euler_characteristic(refined), 2);
+    EXPECT_LT(report.max_abs_phi, 1e-12);  // split points are moved onto φ = 0
+    // Edges straddling the crease line are halved; far from it the mesh is the plain one.
+    const auto crease_distance = [](const Vec3& p) { return std::abs(std::abs(p.x()) - A2_CREASE_X); };
+    const auto mean_across = [](const SurfaceMesh& m) {  // edges straddling the crease line
+        double sum = 0.0;
+        int n = 0;
+        for (int ei = 0; ei < m.num_edges(); ++ei) {
+            if (!m.edge_alive(ei))
+                continue;
+            const Vec3 a = m.position(m.edge(ei)[0]), b = m.position(m.edge(ei)[1]);
+            if ((std::abs(a.x()) - A2_CREASE_X) * (std::abs(b.x()) - A2_CREASE_X) < 0.0) {
+                sum += (a - b).norm();
+                ++n;
+            }
+        }
+        return n > 0 ? sum / n : 0.0;
+    };
+    EXPECT_GT(mean_across(plain), 0.8 * xi);
+    EXPECT_LT(mean_across(refined), 0.7 * mean_across(plain));
+    const auto far_positions = [&](const SurfaceMesh& m) {
+        std::vector<std::array<double, 3>> p;
+        for (int vi = 0; vi < m.num_vertices(); ++vi)
+            if (m.vertex_alive(vi) && crease_distance(m.position(vi)) > 4.0 * xi)
+                p.push_back({m.position(vi).x(), m.position(vi).y(), m.position(vi).z()});
+        std::sort(p.begin(), p.end());
+        return p;
+    };
+    EXPECT_EQ(far_positions(refined), far_positions(plain));
+    EXPECT_GT(refined.count_live_triangles(), plain.count_live_triangles());
+}
+
+TEST(ImplicitMesher, CreaseRefinementLeavesASmoothShapeAlone) {
+    ImplicitMeshOptions options;
+    options.edge_length = 0.04;
+    const ShapePtr sphere = make_sphere({0, 0, 0}, 0.3);
+    const SurfaceMesh plain = mesh_implicit_shape(*sphere, options);
+    options.crease.levels = 2;
+    ImplicitMeshReport report;
+    const SurfaceMesh refined = mesh_implicit_shape(*sphere, options, &report);
+    EXPECT_EQ(report.crease_vertices, 0);  // an edge turns by about 0.13 rad < 0.35
+    EXPECT_EQ(report.crease_splits, 0);
+    EXPECT_EQ(refined.count_live_triangles(), plain.count_live_triangles());
+}
+
+TEST(ImplicitMesher, CreaseOptionsAreValidatedByName) {
+    ImplicitMeshOptions options;
+    options.edge_length = 0.04;
+    const auto message = [&options]() -> std::string {
+        try {
+            options.validate();
+        } catch (const std::invalid_argument& e) {
+            return e.what();
+        }
+        return "";
+    };
+    options.crease.levels = 5;
+    EXPECT_NE(message().find("crease.levels"), std::string::npos);
+    options.crease.levels = 1;
+    options.crease.angle = 0.0;
+    EXPECT_NE(message().find("crease.angle"), std::string::npos);
+    options.crease.angle = 0.35;
+    options.crease.band = -1.0;
+    EXPECT_NE(message().find("crease.band"), std::string::npos);
+    options.crease.band = 0.0;
+    EXPECT_EQ(message(), "");
 }
 
 TEST(ImplicitMesher, ShapeSmallerThanTheGridGivesAClearError) {
