@@ -292,7 +292,8 @@ void check_intersection_free(const SurfaceMesh& mesh, const std::string& what) {
 }  // namespace
 
 /// The initial surface's geometry and connectivity (labels still the default: liquid inside).
-static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::string* report) {
+static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::string* report,
+                                                  double* nominal_xi) {
     if (scene.shape) {
         tracker::ImplicitMeshOptions options;
         options.edge_length = scene.surface.edge_length;
@@ -319,6 +320,8 @@ static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::strin
                   << r.crease_vertices << " crease vertices";
             *report = s.str();
         }
+        if (nominal_xi && r.crease_splits > 0)
+            *nominal_xi = r.unrefined_mean_edge_length;
         return mesh;
     }
     const std::string& file = scene.surface.mesh_file;
@@ -350,8 +353,17 @@ static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::strin
     return mesh;
 }
 
-SurfaceMesh build_initial_surface(const Scene& scene, std::string* report) {
-    SurfaceMesh mesh = build_initial_surface_geometry(scene, report);
+tracker::TrackerOptions tracker_options(const Scene& scene, double nominal_xi) {
+    tracker::TrackerOptions options = scene.tracker;
+    if (options.characteristic_length == 0.0)
+        options.characteristic_length = nominal_xi;
+    return options;
+}
+
+SurfaceMesh build_initial_surface(const Scene& scene, std::string* report, double* nominal_xi) {
+    if (nominal_xi)
+        *nominal_xi = 0.0;
+    SurfaceMesh mesh = build_initial_surface_geometry(scene, report, nominal_xi);
     // /surface/inside: which phase the surface encloses.
     const tracker::LabelPair labels =
         scene.surface.inside == "gas" ? tracker::LabelPair{0, 1} : tracker::LabelPair{1, 0};
@@ -429,7 +441,8 @@ nlohmann::json fluid_frame_stats(int frame, double time, long long steps,
 }
 
 coupling::Simulation make_fluid_simulation(const Scene& scene, std::string* report) {
-    SurfaceMesh initial = build_initial_surface(scene, report);
+    double nominal_xi = 0.0;
+    SurfaceMesh initial = build_initial_surface(scene, report, &nominal_xi);
     const double dx = scene.domain.size.x() / scene.domain.cells;
     const auto cells_along = [&](double size) {
         return std::max(1, static_cast<int>(std::lround(size / dx)));
@@ -438,8 +451,9 @@ coupling::Simulation make_fluid_simulation(const Scene& scene, std::string* repo
                               cells_along(scene.domain.size.z()), dx, scene.domain.min,
                               scene.fluid);
     apply_initial_velocity(scene.initial_velocity, solver.grid());
-    return coupling::Simulation(tracker::SurfaceTracker(std::move(initial), scene.tracker),
-                                std::move(solver), scene.coupling.simulation);
+    return coupling::Simulation(
+        tracker::SurfaceTracker(std::move(initial), tracker_options(scene, nominal_xi)),
+        std::move(solver), scene.coupling.simulation);
 }
 
 RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
@@ -528,7 +542,9 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
         exact.check_end(end_time);
 
     std::string report;
-    tracker::SurfaceTracker tracker(build_initial_surface(scene, &report), scene.tracker);
+    double nominal_xi = 0.0;
+    SurfaceMesh initial = build_initial_surface(scene, &report, &nominal_xi);
+    tracker::SurfaceTracker tracker(std::move(initial), tracker_options(scene, nominal_xi));
     const SurfaceMesh& mesh = tracker.mesh();
     if (!options.quiet)
         std::fprintf(stderr, "%s: %s\n", scene.name.c_str(), report.c_str());

@@ -41,7 +41,13 @@ struct RunResult {
 
 /// Builds the initial surface of a scene (meshing its shape or loading and validating its mesh
 /// file). Throws InputError naming the file and the failed check for a bad mesh file.
-tracker::SurfaceMesh build_initial_surface(const Scene& scene, std::string* report = nullptr);
+/// `nominal_xi` gets the tracker's ξ when the mesh was refined around creases (its mean edge
+/// length before that refinement), else 0: measure it from the mesh.
+tracker::SurfaceMesh build_initial_surface(const Scene& scene, std::string* report = nullptr,
+                                           double* nominal_xi = nullptr);
+/// The scene's tracker options with ξ set to `nominal_xi` unless the scene fixes it (or
+/// `nominal_xi` is 0).
+tracker::TrackerOptions tracker_options(const Scene& scene, double nominal_xi);
 
 /// The coupled simulation of a fluid scene as `meniscus run` sets it up: the grid from /domain
 /// (cubic cells, /domain/cells along x), the initial surface from /surface (build_initial_surface(),

@@ -550,8 +550,9 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
         if (scene.surface.open && scene.shape)
             throw SceneError("/surface/open: only a mesh_file can be open (shapes are closed)");
         if (scene.surface.crease.levels > 0 && !scene.shape)
-            throw SceneError("/surface/crease/levels: crease refinement needs a `shape` (it "
-                             "moves new vertices onto the exact surface)");
+            throw SceneError(
+                "/surface/crease/levels: crease refinement needs a `shape` (it "
+                "moves new vertices onto the exact surface)");
         if (scene.surface.open && scene.flow.type == "fluid")
             throw SceneError("/surface/open: fluid scenes need a closed surface");
         if (!scene.surface.mesh_file.empty() && scene.surface.mesh_file.front() != '/' &&

@@ -49,7 +49,6 @@ RunResult run_tracked(const RunSpec& spec, bool quiet) {
     r.spec = spec;
     tracker::ImplicitMeshOptions mesh_options;
     mesh_options.edge_length = spec.xi_requested;
-    mesh_options.crease = spec.crease;
     tracker::SurfaceTracker tr(tracker::mesh_implicit_shape(*spec.shape, mesh_options),
                                spec.tracker);
     const SurfaceMesh& mesh = tr.mesh();

@@ -7,7 +7,6 @@
 
 #include "tracker/flows/flow_errors.h"
 #include "tracker/flows/flow_runner.h"
-#include "tracker/implicit_mesher.h"
 #include "tracker/implicit_shape.h"
 #include "tracker/surface_tracker.h"
 
@@ -36,7 +35,6 @@ struct RunSpec {
     std::string case_id;  ///< "A1", …
     std::string label;    ///< e.g. "face offsetting"
     double xi_requested = 0.0;
-    tracker::CreaseRefinementOptions crease;  ///< of the initial mesh
     tracker::ShapePtr shape;
     tracker::TrackerOptions tracker;
     std::shared_ptr<const tracker::FlowStepper> stepper;

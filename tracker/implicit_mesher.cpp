@@ -183,8 +183,8 @@ Vec3 unit_normal(const ImplicitShape& shape, const Vec3& x) {
 
 /// Midpoints of the edges whose end normals turn by more than `angle`: points within half an
 /// edge of the shape's creases.
-std::vector<Vec3> crease_points(const SurfaceMesh& mesh, const ImplicitShape& shape,
-                                double angle, int* crease_vertices) {
+std::vector<Vec3> crease_points(const SurfaceMesh& mesh, const ImplicitShape& shape, double angle,
+                                int* crease_vertices) {
     std::vector<Vec3> normal(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
     for (int vi = 0; vi < mesh.num_vertices(); ++vi)
         if (mesh.vertex_alive(vi))
@@ -251,8 +251,8 @@ int refine_creases(SurfaceMesh& mesh, const ImplicitShape& shape,
         crease.band > 0.0 ? crease.band : DEFAULT_CREASE_BAND_EDGES * options.edge_length;
     int splits = 0;
     for (int pass = 0; pass < crease.levels; ++pass) {
-        const std::vector<Vec3> points = crease_points(mesh, shape, crease.angle,
-                                                       pass == 0 ? crease_vertices : nullptr);
+        const std::vector<Vec3> points =
+            crease_points(mesh, shape, crease.angle, pass == 0 ? crease_vertices : nullptr);
         if (points.empty())
             break;
         const PointGrid grid(points, band);
@@ -326,9 +326,11 @@ SurfaceMesh mesh_implicit_shape(const ImplicitShape& shape, const ImplicitMeshOp
     isotropic_remesh(mesh, remesh, [&shape, newton](const Vec3& p) {
         return project_to_zero_set(shape, p, newton);
     });
+    const double unrefined_mean_edge_length = edge_length_stats(mesh).mean;
     int crease_vertices = 0;
     const int crease_splits = refine_creases(mesh, shape, options, &crease_vertices);
     if (report) {
+        report->unrefined_mean_edge_length = unrefined_mean_edge_length;
         report->crease_vertices = crease_vertices;
         report->crease_splits = crease_splits;
         report->vertices = mesh.count_live_vertices();

@@ -17,11 +17,14 @@ namespace meniscus::tracker {
 /// `band` of a crease point, the midpoint of an edge whose end normals ∇φ/|∇φ| turn by more
 /// than `angle`. Under mean-curvature flow a crease rounds off at once over a width growing as
 /// √t; sampled at edge_length that rounding starts wrong, and a concave crease lags by a dent
-/// that diffuses into the neighbouring surface (app/validate_parameters.h has the numbers).
+/// that diffuses into the neighbouring surface. Refined once, the A2 dumbbell's vertex L1 up to
+/// its pinch is 2–3× smaller (app/validate_parameters.h). Give a tracker of the refined mesh the
+/// unrefined ξ (ImplicitMeshReport::unrefined_mean_edge_length,
+/// TrackerOptions::characteristic_length), or every size it derives from ξ shrinks too.
 struct CreaseRefinementOptions {
-    int levels = 0;      ///< halvings, in [0, 4]; 0 = off
-    double angle = 0.35; ///< radians, in (0, π)
-    double band = 0.0;   ///< metres, ≥ 0; 0 = 2·edge_length
+    int levels = 0;         ///< halvings, in [0, 4]; 0 = off
+    double angle = 0.35;    ///< radians, in (0, π)
+    double band = 0.0;      ///< metres, ≥ 0; 0 = 2·edge_length
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
 
@@ -42,8 +45,11 @@ struct ImplicitMeshReport {
     double min_angle_degrees = 0.0;
     double max_angle_degrees = 0.0;
     double max_abs_phi = 0.0;  ///< largest |φ| over vertices (how far off the surface)
-    int crease_vertices = 0;   ///< crease vertices found before crease refinement
-    int crease_splits = 0;     ///< edges split by crease refinement
+    /// Mean edge length before crease refinement: the nominal ξ of a locally refined mesh
+    /// (TrackerOptions::characteristic_length).
+    double unrefined_mean_edge_length = 0.0;
+    int crease_vertices = 0;  ///< crease vertices found before crease refinement
+    int crease_splits = 0;    ///< edges split by crease refinement
 };
 
 /// Meshes `shape`. Throws std::invalid_argument on bad options or an unbounded shape (a

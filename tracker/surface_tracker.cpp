@@ -13,6 +13,8 @@ namespace meniscus::tracker {
 void TrackerOptions::validate() const {
     if (!(proximity_fraction > 0.0) || !std::isfinite(proximity_fraction))
         throw std::invalid_argument("proximity_fraction: expected a number > 0");
+    if (!(characteristic_length >= 0.0) || !std::isfinite(characteristic_length))
+        throw std::invalid_argument("characteristic_length: expected a number >= 0");
     try {
         remesh.validate();
     } catch (const std::invalid_argument& e) {
@@ -40,7 +42,8 @@ void TrackerOptions::validate() const {
 SurfaceTracker::SurfaceTracker(SurfaceMesh mesh, const TrackerOptions& options)
     : m_mesh(std::move(mesh)), m_options(options) {
     m_options.validate();
-    m_xi = edge_length_stats(m_mesh).mean;
+    m_xi = m_options.characteristic_length > 0.0 ? m_options.characteristic_length
+                                                 : edge_length_stats(m_mesh).mean;
     if (!(m_xi > 0.0))
         throw std::invalid_argument("SurfaceTracker: the mesh has no edges");
     m_options.collision.proximity_epsilon = m_options.proximity_fraction * m_xi;

@@ -23,6 +23,10 @@ struct TrackerOptions {
     double proximity_fraction = 1e-3;
     /// Run the exact static self-intersection test after every integrate() and report it.
     bool verify_intersection_free = false;
+    /// ξ (metres), the length α, β, γ and ε_p scale with. 0: the initial mesh's mean edge
+    /// length (the paper's ξ). Set it to the nominal edge length when the initial mesh is
+    /// refined locally (ImplicitMeshOptions::crease), which would otherwise shrink every size.
+    double characteristic_length = 0.0;
     /// Collision resolution tuning; its proximity_epsilon is overwritten from
     /// proximity_fraction · ξ.
     CollisionOptions collision;

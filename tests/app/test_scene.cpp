@@ -1,5 +1,7 @@
 #include "app/json_fields.h"
+#include "app/run.h"
 #include "app/scene.h"
+#include "tracker/mesh_measures.h"
 
 #include <gtest/gtest.h>
 
@@ -58,6 +60,23 @@ TEST(Scene, SurfaceCreaseRefinementIsReadAndChecked) {
     EXPECT_NE(error_of(R"({"surface": {"mesh_file": "m.obj", "crease": {"levels": 1}}})")
                   .find("/surface/crease/levels: crease refinement needs a `shape`"),
               std::string::npos);
+}
+
+TEST(Scene, CreaseRefinedSurfaceGivesTheTrackerItsUnrefinedXi) {
+    const std::string shape =
+        R"("shape": {"type": "dumbbell", "bulb_radius": 0.3, "handle_radius": 0.2, "blend_radius": 0})";
+    const Scene plain =
+        parse_scene(R"({"surface": {"edge_length": 0.04, )" + shape + "}}", "t.json", ".");
+    const Scene refined =
+        parse_scene(R"({"surface": {"edge_length": 0.04, "crease": {"levels": 1}, )" + shape + "}}",
+                    "t.json", ".");
+    double xi_plain = -1.0, xi_refined = -1.0;
+    const tracker::SurfaceMesh plain_mesh = build_initial_surface(plain, nullptr, &xi_plain);
+    const tracker::SurfaceMesh refined_mesh = build_initial_surface(refined, nullptr, &xi_refined);
+    EXPECT_EQ(xi_plain, 0.0);  // measure it from the mesh, as the paper does
+    EXPECT_DOUBLE_EQ(xi_refined, tracker::edge_length_stats(plain_mesh).mean);
+    EXPECT_GT(refined_mesh.count_live_triangles(), plain_mesh.count_live_triangles());
+    EXPECT_DOUBLE_EQ(tracker_options(refined, xi_refined).characteristic_length, xi_refined);
 }
 
 TEST(Scene, ErrorsNameTheJsonPath) {

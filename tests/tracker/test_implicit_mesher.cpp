@@ -2,6 +2,7 @@
 #include "tracker/mesh_intersections.h"
 #include "tracker/mesh_measures.h"
 #include "tracker/mesh_validate.h"
+#include "tracker/surface_tracker.h"
 
 #include <gtest/gtest.h>
 
@@ -103,7 +104,9 @@ TEST(ImplicitMesher, CreaseRefinementHalvesEdgesNearTheCreaseOnlyWithVerticesOnT
     EXPECT_EQ(euler_characteristic(refined), 2);
     EXPECT_LT(report.max_abs_phi, 1e-12);  // split points are moved onto φ = 0
     // Edges straddling the crease line are halved; far from it the mesh is the plain one.
-    const auto crease_distance = [](const Vec3& p) { return std::abs(std::abs(p.x()) - A2_CREASE_X); };
+    const auto crease_distance = [](const Vec3& p) {
+        return std::abs(std::abs(p.x()) - A2_CREASE_X);
+    };
     const auto mean_across = [](const SurfaceMesh& m) {  // edges straddling the crease line
         double sum = 0.0;
         int n = 0;
@@ -130,6 +133,30 @@ TEST(ImplicitMesher, CreaseRefinementHalvesEdgesNearTheCreaseOnlyWithVerticesOnT
     };
     EXPECT_EQ(far_positions(refined), far_positions(plain));
     EXPECT_GT(refined.count_live_triangles(), plain.count_live_triangles());
+}
+
+TEST(ImplicitMesher, CreaseRefinedMeshKeepsItsNominalXiInTheTracker) {
+    ImplicitMeshOptions options;
+    options.edge_length = 0.04;
+    options.crease.levels = 1;
+    ImplicitMeshReport report;
+    const SurfaceMesh mesh =
+        mesh_implicit_shape(*make_dumbbell({0, 0, 0}, 0.3, 1.0, 0.2, 0.0), options, &report);
+    ASSERT_GT(report.crease_splits, 0);
+    EXPECT_LT(report.mean_edge_length, 0.95 * report.unrefined_mean_edge_length);
+    TrackerOptions tracker;
+    EXPECT_DOUBLE_EQ(SurfaceTracker(mesh, tracker).characteristic_length(),
+                     edge_length_stats(mesh).mean);  // measured: every size would shrink
+    tracker.characteristic_length = report.unrefined_mean_edge_length;
+    EXPECT_DOUBLE_EQ(SurfaceTracker(mesh, tracker).characteristic_length(),
+                     report.unrefined_mean_edge_length);
+    tracker.characteristic_length = -1.0;
+    try {
+        SurfaceTracker bad(mesh, tracker);
+        ADD_FAILURE() << "a negative characteristic_length was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("characteristic_length"), std::string::npos);
+    }
 }
 
 TEST(ImplicitMesher, CreaseRefinementLeavesASmoothShapeAlone) {
