@@ -125,7 +125,8 @@ void visit_fields(V& v, SurfaceOptions& o) {
     v.integer("remesh_iterations", o.remesh_iterations, Range::between(0, 100), "",
               "isotropic remeshing passes after marching tetrahedra");
     v.section("crease", "refinement around the shape's creases after meshing", [&](auto& r) {
-        r.integer("levels", o.crease.levels, Range::between(0, 4), "",
+        r.integer("levels", o.crease.levels,
+                  Range::between(0, tracker::CreaseRefinementOptions::MAX_LEVELS), "",
                   "edge halvings near creases (0 = off)");
         r.number("angle", o.crease.angle, Range{0.0, M_PI, true, true}, "rad",
                  "an edge whose end normals turn by more than this crosses a crease");

@@ -1,5 +1,6 @@
 #include "tracker/implicit_mesher.h"
 
+#include "tracker/broadphase.h"
 #include "tracker/isotropic_remesh.h"
 #include "tracker/mesh_measures.h"
 
@@ -26,8 +27,6 @@ constexpr int PADDING_CELLS = 2;
 /// Keep crossings this fraction of a grid edge away from grid nodes (no zero-length edges).
 constexpr double MIN_CROSSING_PARAMETER = 1e-3;
 
-/// Crease refinement halves edges at most this many times (16× finer than edge_length).
-constexpr int MAX_CREASE_LEVELS = 4;
 /// Crease band relative to edge_length when CreaseRefinementOptions::band is 0.
 constexpr double DEFAULT_CREASE_BAND_EDGES = 2.0;
 
@@ -206,42 +205,15 @@ std::vector<Vec3> crease_points(const SurfaceMesh& mesh, const ImplicitShape& sh
     return points;
 }
 
-/// Points bucketed on a grid of cell size `radius`, for "is any point within radius" queries.
-class PointGrid {
-public:
-    PointGrid(const std::vector<Vec3>& points, double radius) : m_points(points), m_r(radius) {
-        for (size_t i = 0; i < points.size(); ++i)
-            m_cells[key(cell(points[i]))].push_back(static_cast<int>(i));
-    }
-    bool any_within(const Vec3& x) const {
-        const std::array<long, 3> c = cell(x);
-        for (long dx = -1; dx <= 1; ++dx)
-            for (long dy = -1; dy <= 1; ++dy)
-                for (long dz = -1; dz <= 1; ++dz) {
-                    const auto it = m_cells.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
-                    if (it == m_cells.end())
-                        continue;
-                    for (int i : it->second)
-                        if ((m_points[static_cast<size_t>(i)] - x).squaredNorm() <= m_r * m_r)
-                            return true;
-                }
-        return false;
-    }
-
-private:
-    std::array<long, 3> cell(const Vec3& x) const {
-        return {static_cast<long>(std::floor(x.x() / m_r)),
-                static_cast<long>(std::floor(x.y() / m_r)),
-                static_cast<long>(std::floor(x.z() / m_r))};
-    }
-    static std::uint64_t key(const std::array<long, 3>& c) {
-        const auto part = [](long v) { return static_cast<std::uint64_t>(v) & 0x1fffffu; };
-        return part(c[0]) | (part(c[1]) << 21) | (part(c[2]) << 42);
-    }
-    const std::vector<Vec3>& m_points;
-    double m_r;
-    std::unordered_map<std::uint64_t, std::vector<int>> m_cells;
-};
+/// True when a crease point lies within `radius` of x (`hash` holds the points as boxes).
+bool near_crease(const SpatialHash& hash, const std::vector<Vec3>& points, const Vec3& x,
+                 double radius, std::vector<int>& candidates) {
+    hash.query(Box3d(x - Vec3::Constant(radius), x + Vec3::Constant(radius)), candidates);
+    for (int i : candidates)
+        if ((points[static_cast<size_t>(i)] - x).squaredNorm() <= radius * radius)
+            return true;
+    return false;
+}
 
 /// ImplicitMeshOptions' crease refinement; returns the edges split.
 int refine_creases(SurfaceMesh& mesh, const ImplicitShape& shape,
@@ -255,7 +227,10 @@ int refine_creases(SurfaceMesh& mesh, const ImplicitShape& shape,
             crease_points(mesh, shape, crease.angle, pass == 0 ? crease_vertices : nullptr);
         if (points.empty())
             break;
-        const PointGrid grid(points, band);
+        SpatialHash hash(band);
+        for (size_t i = 0; i < points.size(); ++i)
+            hash.insert(static_cast<int>(i), Box3d(points[i], points[i]));
+        std::vector<int> candidates;
         const double min_length = options.edge_length * std::ldexp(1.0, -(pass + 1));
         const int edges = mesh.num_edges();  // edges made by this pass wait for the next
         for (int ei = 0; ei < edges; ++ei) {
@@ -264,7 +239,7 @@ int refine_creases(SurfaceMesh& mesh, const ImplicitShape& shape,
             const auto& e = mesh.edge(ei);
             const Vec3 a = mesh.position(e[0]), b = mesh.position(e[1]);
             const Vec3 mid = 0.5 * (a + b);
-            if ((a - b).norm() <= min_length || !grid.any_within(mid))
+            if ((a - b).norm() <= min_length || !near_crease(hash, points, mid, band, candidates))
                 continue;
             mesh.split_edge(ei, project_to_zero_set(shape, mid, options.projection_iterations));
             ++splits;
@@ -286,9 +261,9 @@ void ImplicitMeshOptions::validate() const {
 }
 
 void CreaseRefinementOptions::validate() const {
-    if (levels < 0 || levels > MAX_CREASE_LEVELS)
+    if (levels < 0 || levels > MAX_LEVELS)
         throw std::invalid_argument("crease.levels: expected an integer in [0, " +
-                                    std::to_string(MAX_CREASE_LEVELS) + "]");
+                                    std::to_string(MAX_LEVELS) + "]");
     if (!(angle > 0.0 && angle < M_PI))
         throw std::invalid_argument("crease.angle: expected radians in (0, pi)");
     if (!(band >= 0.0) || !std::isfinite(band))

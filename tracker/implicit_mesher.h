@@ -22,10 +22,11 @@ namespace meniscus::tracker {
 /// unrefined ξ (ImplicitMeshReport::unrefined_mean_edge_length,
 /// TrackerOptions::characteristic_length), or every size it derives from ξ shrinks too.
 struct CreaseRefinementOptions {
-    int levels = 0;         ///< halvings, in [0, 4]; 0 = off
-    double angle = 0.35;    ///< radians, in (0, π)
-    double band = 0.0;      ///< metres, ≥ 0; 0 = 2·edge_length
-    void validate() const;  ///< throws std::invalid_argument naming the field
+    static constexpr int MAX_LEVELS = 4;  ///< 16× finer than edge_length at most
+    int levels = 0;                       ///< halvings, in [0, MAX_LEVELS]; 0 = off
+    double angle = 0.35;                  ///< radians, in (0, π)
+    double band = 0.0;                    ///< metres, ≥ 0; 0 = 2·edge_length
+    void validate() const;                ///< throws std::invalid_argument naming the field
 };
 
 /// Options of mesh_implicit_shape().
