@@ -389,6 +389,10 @@ void visit_fields(V& v, tracker::TrackerOptions& o) {
               "merging and pinch-off on/off (paper §3.3 switch)");
     v.boolean("collision_safety", o.collision_safety,
               "keep the mesh intersection-free (paper §3.3 switch; off shows why it exists)");
+    v.number("characteristic_length", o.characteristic_length, Range::non_negative(), "m",
+             "ξ, which every length fraction multiplies; 0 = the initial mesh's mean edge length "
+             "(the unrefined one with /surface/crease); set it to restart from a saved frame "
+             "at the original resolution");
     v.number("proximity_fraction", o.proximity_fraction, Range::positive(), "ξ",
              "repulsion distance ε_p as a fraction of the initial mean edge length ξ");
     v.boolean("verify_intersection_free", o.verify_intersection_free,

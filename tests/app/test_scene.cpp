@@ -79,6 +79,18 @@ TEST(Scene, CreaseRefinedSurfaceGivesTheTrackerItsUnrefinedXi) {
     EXPECT_DOUBLE_EQ(tracker_options(refined, xi_refined).characteristic_length, xi_refined);
 }
 
+TEST(Scene, FixedCharacteristicLengthWinsOverTheMeshedOne) {
+    const Scene s = parse_scene(
+        R"({"surface": {"shape": {"type": "sphere"}}, "tracker": {"characteristic_length": 0.05}})",
+        "t.json", ".");
+    EXPECT_DOUBLE_EQ(tracker_options(s, 0.03).characteristic_length, 0.05);
+    EXPECT_NE(
+        error_of(
+            R"({"surface": {"shape": {"type": "sphere"}}, "tracker": {"characteristic_length": -1}})")
+            .find("/tracker/characteristic_length: expected a number >= 0"),
+        std::string::npos);
+}
+
 TEST(Scene, ErrorsNameTheJsonPath) {
     EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "fluids": {}})")
                   .find("test.json: /fluids: unknown key"),
