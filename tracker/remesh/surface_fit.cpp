@@ -387,19 +387,16 @@ std::optional<SurfacePatch> vertex_patch_at(const SurfaceMesh& mesh, const Posit
     if (mesh.vertex_triangles(vi).empty() || mesh.is_boundary_vertex(vi))
         return std::nullopt;
     // The one-ring alone (about 7 vertices) barely determines 6 coefficients: fit the two-ring.
-    thread_local std::vector<int> ring, vertices, triangles;  // per-thread scratch
-    ring.clear();
+    thread_local std::vector<int> one_ring, ring, vertices, triangles;  // per-thread scratch
+    one_ring.clear();
     vertices.clear();
     triangles.clear();
-    append_one_ring(mesh, vi, ring);
+    append_one_ring(mesh, vi, one_ring);
     // Each neighbour appears once per triangle it shares with vi: expand it once. Its later
     // repeats only repeated ids already listed (the fit's vertex order is unchanged) and
     // tripled the work of every fit.
-    for (size_t i = 0; i < ring.size(); ++i) {
-        const int w = ring[i];
-        if (std::find(ring.begin(), ring.begin() + static_cast<std::ptrdiff_t>(i), w) !=
-            ring.begin() + static_cast<std::ptrdiff_t>(i))
-            continue;
+    unique_in_order(one_ring, ring);
+    for (int w : ring) {
         append_one_ring(mesh, w, vertices);
         triangles.insert(triangles.end(), mesh.vertex_triangles(w).begin(),
                          mesh.vertex_triangles(w).end());
