@@ -251,6 +251,7 @@ TEST_F(CliTest, InterruptFinishesCleanly) {
       "time": {"end": 3000, "frames": 1000, "dt": 0.01}, "output": {"vdb": false}})");
     const fs::path out = m_dir / "out";
     const fs::path log = m_dir / "log.txt";
+    const std::string out_dir = out.string();  // built before fork: the child only execs
     const pid_t pid = fork();
     ASSERT_GE(pid, 0);
     if (pid == 0) {
@@ -259,7 +260,6 @@ TEST_F(CliTest, InterruptFinishesCleanly) {
             _exit(127);
         dup2(fd, STDOUT_FILENO);
         dup2(fd, STDERR_FILENO);
-        const std::string out_dir = out.string();
         execl(MENISCUS_BINARY, MENISCUS_BINARY, "run", scene.c_str(), "--out", out_dir.c_str(),
               "--quiet", static_cast<char*>(nullptr));
         _exit(127);
