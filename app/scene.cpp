@@ -305,6 +305,9 @@ void visit_fields(V& v, tracker::RemeshOptions& o) {
              "curvature-adaptive sizing (not in the paper; A2 uses 0.7; needs "
              "split_on_fitted_surface): where the surface has curvature κ, α and β shrink so edges "
              "turn by at most this angle (α·s, β·s with s = min(1, c/(κα))); 0 keeps α and β");
+    v.boolean("curvature_sizing_convex_only", o.curvature_sizing_convex_only,
+              "curvature-adaptive sizing refines only where the surface is convex (largest "
+              "positive principal curvature): tips and necks, not concave creases");
     v.number("min_curvature_size_fraction", o.min_curvature_size_fraction,
              Range{0.0, 1.0, true, false}, "",
              "smallest factor s of curvature-adaptive and thin-sheet sizing (α and β never fall "

@@ -40,6 +40,14 @@ struct RemeshOptions {
     /// (a static dumbbell handle went from 18 to 700 vertices in 12 improvements, splitting and
     /// collapsing 600 edges each; with fitted points it settled at 270 in 3).
     double curvature_edge_fraction = 0.0;
+    /// Curvature-adaptive sizing sees only convex turning (the largest positive principal
+    /// curvature, outward normals) instead of the largest in magnitude: tips and necks refine,
+    /// concave creases do not. Not in the paper. On the A2 dumbbell the concave crease where
+    /// the handle meets the balls is a kink at t = 0 that the flow rounds within a layer
+    /// narrower than an edge; refined by splits on fitted surfaces it overfills, so with
+    /// c = 0.35 every vertex ended outside at ξ = 0.02 (vertex L∞ 9.8e-5 at t = 0.025), while
+    /// the just-pinched convex tips need that finer c (app/validate_parameters.h).
+    bool curvature_sizing_convex_only = false;
     /// Smallest s of curvature-adaptive sizing, in (0, 1]: α and β never fall below this
     /// fraction (thin folds would otherwise refine without bound).
     double min_curvature_size_fraction = 0.25;

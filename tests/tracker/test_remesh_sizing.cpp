@@ -51,6 +51,52 @@ TEST(RemeshSizing, TurningCurvatureIsTheInverseRadiusOnASphereAndATorusTube) {
     EXPECT_NEAR(median(kt), 1.0 / 0.12, 0.1 / 0.12);
 }
 
+/// The sphere with its triangles reversed: a spherical cavity, concave everywhere.
+SurfaceMesh make_cavity() {
+    const SurfaceMesh sphere = testing::make_test_sphere();
+    std::vector<Triangle> triangles;
+    for (int ti = 0; ti < sphere.num_triangles(); ++ti) {
+        const Triangle& t = sphere.triangle(ti);
+        triangles.push_back({t[0], t[2], t[1]});
+    }
+    return SurfaceMesh(sphere.positions(), triangles);
+}
+
+TEST(RemeshSizing, ConvexOnlyCurvatureIsZeroInACavityAndTheTubeCurvatureOnATorus) {
+    const SurfaceMesh cavity = make_cavity();
+    const std::vector<Vec3> normals = area_weighted_vertex_normals(cavity);
+    const std::vector<double> magnitude = live_values(cavity, vertex_turning_curvature(cavity));
+    const std::vector<double> convex =
+        live_values(cavity, vertex_turning_curvature(cavity, normals, true));
+    EXPECT_NEAR(median(magnitude), 1.0 / 0.25, 0.05 / 0.25);
+    EXPECT_EQ(*std::max_element(convex.begin(), convex.end()), 0.0);
+
+    const SurfaceMesh sphere = testing::make_test_sphere();
+    const std::vector<double> ks = live_values(
+        sphere, vertex_turning_curvature(sphere, area_weighted_vertex_normals(sphere), true));
+    EXPECT_NEAR(median(ks), 1.0 / 0.25, 0.05 / 0.25);
+    EXPECT_GT(*std::min_element(ks.begin(), ks.end()), 0.8 / 0.25);
+    // The torus's tube bends convexly everywhere, its inner ring concavely: the tube wins.
+    const SurfaceMesh torus = testing::make_test_torus();
+    const std::vector<double> kt = live_values(
+        torus, vertex_turning_curvature(torus, area_weighted_vertex_normals(torus), true));
+    EXPECT_NEAR(median(kt), 1.0 / 0.12, 0.1 / 0.12);
+
+    // Sizing: with a c that refines the cavity everywhere, convex_only leaves it nominal.
+    const double xi = testing::mean_edge_length(cavity);
+    RemeshOptions options;
+    options.curvature_edge_fraction = 1e-3;
+    options.split_on_fitted_surface = true;
+    const EdgeSizing both(cavity, options, xi);
+    options.curvature_sizing_convex_only = true;
+    const EdgeSizing convex_sizing(cavity, options, xi);
+    for (int ei = 0; ei < cavity.num_edges(); ++ei) {
+        const Edge& e = cavity.edge(ei);
+        ASSERT_EQ(both.scale(e[0], e[1]), options.min_curvature_size_fraction);
+        ASSERT_EQ(convex_sizing.scale(e[0], e[1]), 1.0);
+    }
+}
+
 TEST(RemeshSizing, ScaleIsOneWhenOffAndClampedBetweenTheFloorAndOneWhenOn) {
     const SurfaceMesh torus = testing::make_test_torus();
     const double xi = testing::mean_edge_length(torus);

@@ -22,7 +22,7 @@ std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh) {
 }
 
 std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh,
-                                             const std::vector<Vec3>& normals) {
+                                             const std::vector<Vec3>& normals, bool convex_only) {
     if (normals.size() != static_cast<size_t>(mesh.num_vertices()))
         throw std::invalid_argument("vertex_turning_curvature: one normal per vertex needed");
     std::vector<double> curvature(static_cast<size_t>(mesh.num_vertices()), 0.0);
@@ -49,8 +49,10 @@ std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh,
             const Eigen::Vector2d dn(dn3.dot(t1), dn3.dot(t2));
             dd += d * d.transpose() / length2;
             nd += dn * d.transpose() / length2;
-            max_turning = std::max(max_turning, std::atan2(n.cross(nw).norm(), n.dot(nw)) /
-                                                    std::sqrt(length2));
+            if (!convex_only || dn3.dot(x) > 0.0) {
+                max_turning = std::max(
+                    max_turning, std::atan2(n.cross(nw).norm(), n.dot(nw)) / std::sqrt(length2));
+            }
         }
         // Well-posed when the neighbours span the tangent plane; else the largest turning.
         const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> spread(dd);
@@ -60,7 +62,9 @@ std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh,
             const Eigen::Vector2d k = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
                                           symmetric, Eigen::EigenvaluesOnly)
                                           .eigenvalues();
-            curvature[static_cast<size_t>(vi)] = std::max(std::abs(k(0)), std::abs(k(1)));
+            // Ascending eigenvalues: k(1) is the most convex direction.
+            curvature[static_cast<size_t>(vi)] =
+                convex_only ? std::max(k(1), 0.0) : std::max(std::abs(k(0)), std::abs(k(1)));
         } else {
             curvature[static_cast<size_t>(vi)] = max_turning;
         }
@@ -164,8 +168,11 @@ EdgeSizing::EdgeSizing(const SurfaceMesh& mesh, const RemeshOptions& options, do
     const double floor = options.min_curvature_size_fraction;
     m_scale.assign(curvature.size(), 1.0);
     if (c > 0.0) {
+        const std::vector<double> sized = options.curvature_sizing_convex_only
+                                              ? vertex_turning_curvature(mesh, normals, true)
+                                              : curvature;
         for (size_t vi = 0; vi < curvature.size(); ++vi) {
-            const double k = curvature[vi] * alpha;
+            const double k = sized[vi] * alpha;
             if (k > c)
                 m_scale[vi] = std::max(floor, c / k);
         }

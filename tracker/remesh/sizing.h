@@ -8,7 +8,8 @@
 /// by at most about c radians, and β/α keeps its ratio so splits and collapses never undo each
 /// other. κ at a vertex is the larger principal curvature, in magnitude, of a least-squares fit
 /// of the vertex normals' variation over its one-ring (1/r on a sphere or a tube of radius r,
-/// at any resolution).
+/// at any resolution); with RemeshOptions::curvature_sizing_convex_only the larger positive
+/// one (concave creases keep α and β).
 ///
 /// With RemeshOptions::thin_sheet_sag_fraction = f > 0, s is also at most sqrt(8 f h / κ) / α
 /// (floored at s_min) where the vertex faces another part of the surface at distance h
@@ -28,9 +29,13 @@ namespace meniscus::tracker {
 /// the plane, the largest angle(n_v, n_w) / |x_v − x_w|. 0 for dead or isolated vertices.
 /// Sized num_vertices().
 std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh);
-/// The same from given unit (or zero) vertex normals, sized num_vertices().
+/// The same from given unit (or zero) vertex normals, sized num_vertices(). With
+/// `convex_only`, the largest eigenvalue of S floored at 0 (positive where the surface bends
+/// away from its outward normal, as on a sphere), and in the fallback only neighbours with
+/// (n_w − n_v)·(x_w − x_v) > 0 count: 0 on a concave surface.
 std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh,
-                                             const std::vector<Vec3>& normals);
+                                             const std::vector<Vec3>& normals,
+                                             bool convex_only = false);
 
 /// Per-vertex distance (m) to the nearest live triangle that does not contain the vertex and
 /// faces it: the triangle's normal opposes the vertex normal (n_t · n_v < −1/2), as the other
