@@ -168,9 +168,11 @@ EdgeSizing::EdgeSizing(const SurfaceMesh& mesh, const RemeshOptions& options, do
     const double floor = options.min_curvature_size_fraction;
     m_scale.assign(curvature.size(), 1.0);
     if (c > 0.0) {
-        const std::vector<double> sized = options.curvature_sizing_convex_only
-                                              ? vertex_turning_curvature(mesh, normals, true)
-                                              : curvature;
+        std::vector<double> convex;
+        if (options.curvature_sizing_convex_only)
+            convex = vertex_turning_curvature(mesh, normals, true);
+        const std::vector<double>& sized =
+            options.curvature_sizing_convex_only ? convex : curvature;
         for (size_t vi = 0; vi < curvature.size(); ++vi) {
             const double k = sized[vi] * alpha;
             if (k > c)
