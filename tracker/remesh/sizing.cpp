@@ -163,18 +163,20 @@ EdgeSizing::EdgeSizing(const SurfaceMesh& mesh, const RemeshOptions& options, do
     if (c == 0.0 && f == 0.0)
         return;
     const std::vector<Vec3> normals = area_weighted_vertex_normals(mesh);
-    const std::vector<double> curvature = vertex_turning_curvature(mesh, normals);
+    const bool convex_sizing = c > 0.0 && options.curvature_sizing_convex_only;
+    // The magnitude estimate feeds thin-sheet sizing and, unless convex-only, curvature sizing.
+    std::vector<double> curvature;
+    if (f > 0.0 || (c > 0.0 && !convex_sizing))
+        curvature = vertex_turning_curvature(mesh, normals);
     const double alpha = m_limits.max_edge_length;
     const double floor = options.min_curvature_size_fraction;
-    m_scale.assign(curvature.size(), 1.0);
+    m_scale.assign(normals.size(), 1.0);
     if (c > 0.0) {
-        std::vector<double> convex;
-        if (options.curvature_sizing_convex_only)
-            convex = vertex_turning_curvature(mesh, normals, true);
-        const std::vector<double>& sized =
-            options.curvature_sizing_convex_only ? convex : curvature;
-        for (size_t vi = 0; vi < curvature.size(); ++vi) {
-            const double k = sized[vi] * alpha;
+        const std::vector<double> sized =
+            convex_sizing ? vertex_turning_curvature(mesh, normals, true) : std::vector<double>();
+        const std::vector<double>& kappa = convex_sizing ? sized : curvature;
+        for (size_t vi = 0; vi < kappa.size(); ++vi) {
+            const double k = kappa[vi] * alpha;
             if (k > c)
                 m_scale[vi] = std::max(floor, c / k);
         }
