@@ -61,7 +61,8 @@ inline constexpr bool MCF_HEUN = true;
 ///
 /// The third column's ξ = 0.04 and 0.02 rows were run after valence-4 vertices stopped using
 /// the interpolating quartic (fitted_mean_curvature_normals(); before: 2.56e-4 / 1.16e-4 and
-/// 2.91e-5 / 7.3e-6); its ξ = 0.01 row too (before: 2.52e-5 / 9.0e-6), 9134 steps, pinch in frame 44.
+/// 2.91e-5 / 7.3e-6); its ξ = 0.01 row too (before: 2.52e-5 / 9.0e-6), 9134 steps, pinch in
+/// frame 44.
 ///
 /// The single quartic's κ is too small by a fraction of order (ρκ)⁴ over a two-ring of radius
 /// ρ, and at ξ = 0.04, where a two-ring is as wide as a final drop, every drop lagged (mean φ
@@ -125,6 +126,8 @@ inline constexpr bool MCF_HEUN = true;
 ///
 ///   ξ     t        as validated                      crease refined once
 ///   0.01  0.0025   1.83e-5  2.04e-6  −2.04e-6         6.70e-6  7.08e-7  −7.08e-7
+///   0.01  0.005    —                                 4.41e-6  8.02e-7  −8.0e-7
+///   0.01  0.010    —                                 3.43e-6  1.03e-6  −1.03e-6
 ///   0.02  0.010    2.42e-5  4.72e-6  −4.71e-6         9.65e-6  2.06e-6  −2.06e-6
 ///   0.02  0.019    1.95e-5  6.86e-6  −6.86e-6         1.10e-5  2.74e-6  −2.57e-6
 ///   0.02  0.021    6.65e-5  7.29e-6  −7.04e-6         2.64e-5  3.00e-6  −1.96e-6
@@ -133,10 +136,17 @@ inline constexpr bool MCF_HEUN = true;
 ///
 /// Up to the pinch the refined start is 2–3× closer. Across the pinch (t = 0.022) the mean φ
 /// rises by 4.5e-6 (plain) and 8.4e-6 (refined), and the refined run's tips end late (+2.9e-5 at
-/// ξ = 0.02); before, the crease's lead had hidden that lag. So the next error to remove is the
-/// pinch's, and the setup keeps the plain start until a ξ = 0.01 run with the refined start
-/// (about 1.7× the early steps, 12 000 steps in all by extrapolation, 2 h or more) shows the
-/// row it would give.
+/// ξ = 0.02); before, the crease's lead had hidden that lag.
+///
+/// At ξ = 0.01 the pinch costs far less. Runs started from the reference's own surface (meshed
+/// at ξ = 0.005 and coarsened by the tracker to ξ = 0.01 through tracker/characteristic_length)
+/// end at t = 0.025 at vertex L∞ / L1 5.35e-6 / 8.1e-7 from t = 0.0215, through the pinch
+/// (2212 steps; both drops alike, mean φ +8.2e-7 and +8.1e-7), and 2.75e-6 / 5.2e-7 from
+/// t = 0.0225, after it. So the ξ = 0.01 row's 2.59e-5 is carried in from before the pinch:
+/// the plain start's neck is −4.7e-6 on average at t = 0.01 (above), the refined start's
+/// −7.9e-7 to −9.7e-7 (|x| < 0.1; −2.6e-6 at worst on average at the creases, |x| 0.2–0.3).
+/// The setup keeps the plain start until the refined ξ = 0.01 run reaches t = 0.025: it keeps
+/// 63 000 triangles through t = 0.01, about 190 steps and 3 minutes per 0.0005 s, 2.5 h in all.
 inline constexpr const char* A2_QUARTIC_FIT_SUFFIX = ", quartic fit";
 inline constexpr bool A2_QUARTIC_FIT_DUMBBELL_IN_QUICK = false;
 /// A2 collapses keep the new vertex at the butterfly point, on the smooth surface, instead of
