@@ -129,6 +129,7 @@ inline constexpr bool MCF_HEUN = true;
 ///   0.01  0.005    —                                 4.41e-6  8.02e-7  −8.0e-7
 ///   0.01  0.010    —                                 3.43e-6  1.03e-6  −1.03e-6
 ///   0.01  0.015    —                                 6.26e-6  1.44e-6  −1.44e-6
+///   0.01  0.018    —                                 4.16e-6  1.78e-6  −1.78e-6
 ///   0.02  0.010    2.42e-5  4.72e-6  −4.71e-6         9.65e-6  2.06e-6  −2.06e-6
 ///   0.02  0.019    1.95e-5  6.86e-6  −6.86e-6         1.10e-5  2.74e-6  −2.57e-6
 ///   0.02  0.021    6.65e-5  7.29e-6  −7.04e-6         2.64e-5  3.00e-6  −1.96e-6
@@ -146,7 +147,7 @@ inline constexpr bool MCF_HEUN = true;
 /// t = 0.0225, after it. So the ξ = 0.01 row's 2.59e-5 is carried in from before the pinch:
 /// the plain start's neck is −4.7e-6 on average at t = 0.01 (above), the refined start's
 /// −7.9e-7 to −9.7e-7 (|x| < 0.1; −2.6e-6 at worst on average at the creases, |x| 0.2–0.3),
-/// and −1.5e-6 to −1.7e-6 at t = 0.015.
+/// −1.5e-6 to −1.7e-6 at t = 0.015 and −2.1e-6 to −2.4e-6 at t = 0.018.
 /// The setup keeps the plain start until the refined ξ = 0.01 run reaches t = 0.025: it keeps
 /// 63 000 triangles through t = 0.01, about 190 steps and 3 minutes per 0.0005 s, 2.5 h in all.
 inline constexpr const char* A2_QUARTIC_FIT_SUFFIX = ", quartic fit";
