@@ -49,8 +49,13 @@ RunResult run_tracked(const RunSpec& spec, bool quiet) {
     r.spec = spec;
     tracker::ImplicitMeshOptions mesh_options;
     mesh_options.edge_length = spec.xi_requested;
-    tracker::SurfaceTracker tr(tracker::mesh_implicit_shape(*spec.shape, mesh_options),
-                               spec.tracker);
+    mesh_options.crease = spec.crease;
+    tracker::ImplicitMeshReport mesh_report;
+    SurfaceMesh initial = tracker::mesh_implicit_shape(*spec.shape, mesh_options, &mesh_report);
+    tracker::TrackerOptions tracker_options = spec.tracker;
+    if (spec.crease.levels > 0 && tracker_options.characteristic_length == 0.0)
+        tracker_options.characteristic_length = mesh_report.unrefined_mean_edge_length;
+    tracker::SurfaceTracker tr(std::move(initial), tracker_options);
     const SurfaceMesh& mesh = tr.mesh();
     r.xi = tr.characteristic_length();
     r.initial_volume = tracker::enclosed_volume(mesh);
@@ -164,6 +169,7 @@ Json run_json(const RunResult& r) {
             {"label", r.spec.label},
             {"xi_requested", r.spec.xi_requested},
             {"xi", r.xi},
+            {"crease_refinement_levels", r.spec.crease.levels},
             {"t_end", r.spec.t_end},
             {"t_reached", r.t},
             {"completed", r.completed},

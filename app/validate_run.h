@@ -7,6 +7,7 @@
 
 #include "tracker/flows/flow_errors.h"
 #include "tracker/flows/flow_runner.h"
+#include "tracker/implicit_mesher.h"
 #include "tracker/implicit_shape.h"
 #include "tracker/surface_tracker.h"
 
@@ -41,6 +42,9 @@ struct RunSpec {
     double t_end = 0.0;
     double max_dt = 0.0;
     std::vector<double> breakpoints;  ///< steps end exactly on these times
+    /// Refinement of the initial mesh around the shape's creases (off by default); the
+    /// tracker then keeps the unrefined ξ unless `tracker.characteristic_length` is set.
+    tracker::CreaseRefinementOptions crease;
 };
 
 struct RunResult {
