@@ -275,7 +275,7 @@ void case_a2(Context& c) {
     quartic_fit_tracker.remesh.smoothing_fit_max_turn = MCF_QUARTIC_FIT_SMOOTHING_FIT_MAX_TURN;
     const auto mcf_run = [&](const std::string& label, double xi, tracker::ShapePtr shape,
                              const tracker::TrackerOptions& tracker, double t_end,
-                             bool quartic_fit = false) {
+                             bool quartic_fit = false, int crease_levels = 0) {
         RunSpec s;
         s.case_id = "A2";
         s.label = quartic_fit ? label + A2_QUARTIC_FIT_SUFFIX : label;
@@ -285,6 +285,7 @@ void case_a2(Context& c) {
         s.stepper = quartic_fit ? fitted_stepper : stepper;
         s.t_end = t_end;
         s.max_dt = MCF_MAX_DT;
+        s.crease.levels = crease_levels;
         return run_tracked(s, c.quiet);
     };
     {
@@ -411,8 +412,8 @@ void case_a2(Context& c) {
             runs.push_back(mcf_run("dumbbell", xi, dumbbell, mcf_tracker, DUMBBELL_END));
     if (c.runs_quartic_dumbbell())
         for (double xi : dumbbell_xis)
-            runs.push_back(
-                mcf_run("dumbbell", xi, dumbbell, quartic_fit_tracker, DUMBBELL_END, true));
+            runs.push_back(mcf_run("dumbbell", xi, dumbbell, quartic_fit_tracker, DUMBBELL_END,
+                                   true, A2_QUARTIC_FIT_DUMBBELL_CREASE_LEVELS));
     const References refs = pending.get();
     const double widest = widest_section(refs.axis.back(), DUMBBELL_SEPARATION, 0.5 * axi_dx[1]);
     const double axi_trusted =

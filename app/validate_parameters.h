@@ -59,6 +59,12 @@ inline constexpr bool MCF_HEUN = true;
 ///   0.02  5.87e-5 2.22e-5  2.25e-4 1.45e-5  2.94e-5 7.2e-6   1.38e-4 4.51e-5  1.44e-4 7.03e-5
 ///   0.01  1.03e-5 6.4e-6   —                2.59e-5 9.46e-6  4.44e-5 1.27e-5  1.48e-5 1.55e-5
 ///
+/// These rows now start from a mesh refined once around the dumbbell's crease
+/// (A2_QUARTIC_FIT_DUMBBELL_CREASE_LEVELS): "refit, smoothing ≤ 1" with that start gives
+/// 3.30e-4 / 1.27e-4 (ξ = 0.04) and 2.89e-5 / 6.40e-6 (0.02) against the Richardson reference
+/// below, and at ξ = 0.01 6.17e-6 / 2.04e-6 against Δx = 0.000625 (1.12e-5 / 3.50e-6 against
+/// the Richardson reference; see the end of this comment): every row at or below the paper's.
+///
 /// The third column's ξ = 0.04 and 0.02 rows were run after valence-4 vertices stopped using
 /// the interpolating quartic (fitted_mean_curvature_normals(); before: 2.56e-4 / 1.16e-4 and
 /// 2.91e-5 / 7.3e-6); its ξ = 0.01 row too (before: 2.52e-5 / 9.0e-6), 9134 steps, pinch in
@@ -79,19 +85,18 @@ inline constexpr bool MCF_HEUN = true;
 /// 8.1e-5 / 1.1e-5 at ξ = 0.02 (tips ahead again). Spheroid without remeshing at ξ = 0.04
 /// to t = 0.003: max |φ| 7.6e-5 (single quartic) against Meyer's 2.3e-4.
 ///
-/// What keeps the refit's ξ = 0.01 L∞ above the paper's is the initial crease where the handle
+/// What kept the plain start's ξ = 0.01 L∞ above the paper's is the initial crease where the handle
 /// meets the balls (no blend: the surface turns by 0.84 rad there), not the operator. Against a
 /// Richardson-extrapolated reference (Δx 0.00125 and 0.0025; the Δx = 0.000625 one agrees within
-/// 7e-7 at t = 0.02), the ξ = 0.01 run's crease vertices are up to 3.5e-5 inside at t = 0.001
-/// (the mesh cannot follow the sqrt(t)-wide layer in which the crease rounds off); that deficit
-/// spreads along the handle (mean −4.7e-6 at t = 0.01; −1.1e-5 to −1.3e-5 along the neck at
-/// t = 0.0215), the thinner neck pinches early, and the just-pinched tips, retracting at about
-/// 47 m/s by t = 0.025, end 2.5e-5 ahead. At ξ = 0.02 the same run started from a mesh of the
-/// reference's own surface at t = 0.002 (no crease) has its neck +1.5e-6 on average at
-/// t = 0.01, against −6.0e-6 from t = 0. The neck lead barely shrinks from ξ = 0.02 to 0.01
-/// (t = 0.02: −9.6e-6, −7.9e-6), and refining the crease by curvature does not remove it: neck
-/// mean at t = 0.005, ξ = 0.02, with curvature_edge_fraction 0.7 / 0.5 / 0.35: −4.3e-6 /
-/// −5.9e-6 / +5.6e-6.
+/// 7e-7 at t = 0.02), the ξ = 0.01 run's crease vertices are up to 3.5e-5 inside at t = 0.001 (the
+/// mesh cannot follow the sqrt(t)-wide layer in which the crease rounds off); that deficit spreads
+/// along the handle (mean −4.7e-6 at t = 0.01; −1.1e-5 to −1.3e-5 along the neck at t = 0.0215),
+/// the thinner neck pinches early, and the just-pinched tips, retracting at about 47 m/s by
+/// t = 0.025, end 2.5e-5 ahead. At ξ = 0.02 the same run started from a mesh of the reference's own
+/// surface at t = 0.002 (no crease) has its neck +1.5e-6 on average at t = 0.01, against −6.0e-6
+/// from t = 0. The neck lead barely shrinks from ξ = 0.02 to 0.01 (t = 0.02: −9.6e-6, −7.9e-6), and
+/// refining the crease by curvature does not remove it: neck mean at t = 0.005, ξ = 0.02, with
+/// curvature_edge_fraction 0.7 / 0.5 / 0.35: −4.3e-6 / −5.9e-6 / +5.6e-6.
 ///
 /// How the crease is sampled decides the sign (neck |x| < 0.2 mean / crease 0.2 < |x| < 0.36
 /// mean, t = 0.005, ξ = 0.02, against the Richardson reference; none of this is in the A2 setup):
@@ -130,6 +135,10 @@ inline constexpr bool MCF_HEUN = true;
 ///   0.01  0.010    —                                 3.43e-6  1.03e-6  −1.03e-6
 ///   0.01  0.015    —                                 6.26e-6  1.44e-6  −1.44e-6
 ///   0.01  0.018    —                                 4.16e-6  1.78e-6  −1.78e-6
+///   0.01  0.0195   —                                 4.07e-6  2.02e-6  −2.02e-6
+///   0.01  0.0215   1.1e-5 to 1.3e-5 (neck mean)      7.44e-6  2.47e-6
+///   0.01  0.025    2.59e-5  9.46e-6  (Δx = 0.000625)  1.12e-5  3.50e-6  −3.50e-6
+///   0.01  0.025    against Δx = 0.000625              6.17e-6  2.04e-6  −2.04e-6
 ///   0.02  0.010    2.42e-5  4.72e-6  −4.71e-6         9.65e-6  2.06e-6  −2.06e-6
 ///   0.02  0.019    1.95e-5  6.86e-6  −6.86e-6         1.10e-5  2.74e-6  −2.57e-6
 ///   0.02  0.021    6.65e-5  7.29e-6  −7.04e-6         2.64e-5  3.00e-6  −1.96e-6
@@ -140,18 +149,31 @@ inline constexpr bool MCF_HEUN = true;
 /// rises by 4.5e-6 (plain) and 8.4e-6 (refined), and the refined run's tips end late (+2.9e-5 at
 /// ξ = 0.02); before, the crease's lead had hidden that lag.
 ///
-/// At ξ = 0.01 the pinch costs far less. Runs started from the reference's own surface (meshed
-/// at ξ = 0.005 and coarsened by the tracker to ξ = 0.01 through tracker/characteristic_length)
-/// end at t = 0.025 at vertex L∞ / L1 5.35e-6 / 8.1e-7 from t = 0.0215, through the pinch
-/// (2212 steps; both drops alike, mean φ +8.2e-7 and +8.1e-7), and 2.75e-6 / 5.2e-7 from
-/// t = 0.0225, after it. So the ξ = 0.01 row's 2.59e-5 is carried in from before the pinch:
-/// the plain start's neck is −4.7e-6 on average at t = 0.01 (above), the refined start's
-/// −7.9e-7 to −9.7e-7 (|x| < 0.1; −2.6e-6 at worst on average at the creases, |x| 0.2–0.3),
-/// −1.5e-6 to −1.7e-6 at t = 0.015 and −2.1e-6 to −2.4e-6 at t = 0.018.
-/// The setup keeps the plain start until the refined ξ = 0.01 run reaches t = 0.025: it keeps
-/// 63 000 triangles through t = 0.01, about 190 steps and 3 minutes per 0.0005 s, 2.5 h in all.
+/// At ξ = 0.01 the pinch costs far less. Runs started from the reference's own surface (meshed at
+/// ξ = 0.005 and coarsened by the tracker to ξ = 0.01 through tracker/characteristic_length) end at
+/// t = 0.025 at vertex L∞ / L1 5.35e-6 / 8.1e-7 from t = 0.0215, through the pinch (2212 steps;
+/// both drops alike, mean φ +8.2e-7 and +8.1e-7), and 2.75e-6 / 5.2e-7 from t = 0.0225, after it.
+/// So the ξ = 0.01 row's 2.59e-5 is carried in from before the pinch: the plain start's neck is
+/// −4.7e-6 on average at t = 0.01 (above), the refined start's −7.9e-7 to −9.7e-7 (|x| < 0.1;
+/// −2.6e-6 at worst on average at the creases, |x| 0.2–0.3), −1.5e-6 to −1.7e-6 at t = 0.015 and
+/// −2.1e-6 to −2.4e-6 at t = 0.018. At t = 0.0215 the refined start's neck is −3.3e-6 to −3.9e-6 on
+/// average (|x| < 0.1; the plain start's −1.1e-5 to −1.3e-5); it pinches between t = 0.0215 and
+/// 0.022 and ends at t = 0.025 at vertex L∞ / L1 1.12e-5 / 3.50e-6 against the Richardson reference
+/// and 6.17e-6 / 2.04e-6 against Δx = 0.000625 (the references' drops differ by up to 5e-6 after
+/// their pinch), every vertex inside (left drop's mean φ −4.3e-6, right's −2.7e-6, Richardson), 0
+/// intersecting pairs, 12 344 triangles. That run cut its steps at 50 frame times and was continued
+/// from its own frame at t = 0.0185 (saved in double precision, tracker/characteristic_length set
+/// to the unrefined ξ = 0.0102728); it kept 63 000 triangles through t = 0.01, about 190 steps and
+/// 3 minutes per 0.0005 s, 2 h 52 min in all. The refined start is therefore the setup of the
+/// quartic-fit dumbbell rows and of scenes/flows/a2_dumbbell_quartic_fit_xi*.json.
 inline constexpr const char* A2_QUARTIC_FIT_SUFFIX = ", quartic fit";
 inline constexpr bool A2_QUARTIC_FIT_DUMBBELL_IN_QUICK = false;
+/// Crease refinement of the quartic-fit dumbbell rows' initial mesh (RunSpec::crease, scene key
+/// surface/crease/levels: edges within 2ξ of the crease halved once, new vertices on the exact
+/// dumbbell; the tracker keeps the unrefined ξ). Above: it brings ξ = 0.01 from 2.59e-5 to 6.17e-6
+/// (vertex L∞ against Δx = 0.000625; paper 1.48e-5) and keeps ξ = 0.04 and 0.02 far below the
+/// paper. Meyer's rows keep the plain start (the paper's setup).
+inline constexpr int A2_QUARTIC_FIT_DUMBBELL_CREASE_LEVELS = 1;
 /// A2 collapses keep the new vertex at the butterfly point, on the smooth surface, instead of
 /// lifting it to keep the volume (RemeshOptions::collapse_preserves_volume): a shrinking shape
 /// keeps collapsing edges, and each volume-keeping collapse put a vertex outside the surface,

@@ -3,6 +3,9 @@
 /// and report.md.
 
 #include "app/validate.h"
+#include "app/validate_parameters.h"
+#include "tracker/implicit_mesher.h"
+#include "tracker/implicit_shape.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -407,11 +410,11 @@ ValidationOutput run_into_temporary_folder(ValidateOptions options, const std::s
 
 TEST(ValidateCurvatureOperatorSelection, QuarticFitAloneRunsOnlyItsRowsAndItsDumbbellInQuickMode) {
     // Quick A2 with the quartic-fit operator only: its spheroid and (named, so also in quick
-    // mode) its dumbbell at ξ = 0.04; no sphere, no Meyer rows. Its dumbbell meets the paper's
-    // row there: vertex L∞, L1 1.39e-4, 3.4e-5 against the quick reference (Δx = 0.0025) and
-    // 1.91e-4, 4.97e-5 against Δx = 0.000625 (paper 6.18e-4, 2.62e-4). Without the sphere
-    // refit the quartic's one-signed error left every drop outside: 4.98e-4, 2.81e-4, L1 above
-    // the paper's. Its pinch (measured 0.0219193) comes 5.7 µs before the reference's.
+    // mode) its dumbbell at ξ = 0.04; no sphere, no Meyer rows. Its dumbbell, started from the
+    // crease-refined mesh, meets the paper's row there: vertex L∞, L1 3.51e-4, 1.43e-4 against
+    // the quick reference (Δx = 0.0025), 1305 steps, pinch at t = 0.02192 (paper 6.18e-4,
+    // 2.62e-4; from the plain mesh 1.39e-4, 3.4e-5). Without the sphere refit the quartic's
+    // one-signed error left every drop outside: 4.98e-4, 2.81e-4, L1 above the paper's.
     ValidateOptions options;
     options.cases = {"A2"};
     options.curvature_operators = {"quartic_fit"};
@@ -430,7 +433,26 @@ TEST(ValidateCurvatureOperatorSelection, QuarticFitAloneRunsOnlyItsRowsAndItsDum
     EXPECT_GT(dumbbell["pinch_off_time"].get<double>(), A2_PINCH_AFTER);
     EXPECT_LT(dumbbell["pinch_off_time"].get<double>(), A2_PINCH_BEFORE);
     EXPECT_EQ(dumbbell["max_intersecting_pairs"].get<int>(), 0);
+    // The crease-refined start keeps the unrefined mesh's mean edge length as ξ, so every
+    // length fraction of the remeshing is that of the plain ξ = 0.04 run.
+    namespace fv = meniscus::app::flow_validation;
+    ASSERT_GT(fv::A2_QUARTIC_FIT_DUMBBELL_CREASE_LEVELS, 0);
+    EXPECT_EQ(dumbbell["crease_refinement_levels"].get<int>(),
+              fv::A2_QUARTIC_FIT_DUMBBELL_CREASE_LEVELS);
+    meniscus::tracker::ImplicitMeshOptions mesh_options;
+    mesh_options.edge_length = dumbbell["xi_requested"].get<double>();
+    mesh_options.crease.levels = fv::A2_QUARTIC_FIT_DUMBBELL_CREASE_LEVELS;
+    meniscus::tracker::ImplicitMeshReport mesh_report;
+    meniscus::tracker::mesh_implicit_shape(
+        *meniscus::tracker::make_dumbbell(Eigen::Vector3d::Zero(), fv::DUMBBELL_BULB_RADIUS,
+                                          fv::DUMBBELL_SEPARATION, fv::DUMBBELL_HANDLE_RADIUS,
+                                          fv::DUMBBELL_BLEND_RADIUS),
+        mesh_options, &mesh_report);
+    EXPECT_GT(mesh_report.crease_splits, 0);
+    EXPECT_GT(mesh_report.unrefined_mean_edge_length, mesh_report.mean_edge_length);
+    EXPECT_DOUBLE_EQ(dumbbell["xi"].get<double>(), mesh_report.unrefined_mean_edge_length);
     EXPECT_NE(o.report.find("### Dumbbell with the quartic-fit operator"), std::string::npos);
+    EXPECT_NE(o.report.find("Their initial mesh is refined around the crease"), std::string::npos);
     EXPECT_NE(o.report.find("left out by `--curvature-operator`"), std::string::npos);
 }
 
