@@ -64,6 +64,12 @@ inline constexpr bool MCF_HEUN = true;
 /// 3.30e-4 / 1.27e-4 (ξ = 0.04) and 2.89e-5 / 6.40e-6 (0.02) against the Richardson reference
 /// below, and at ξ = 0.01 6.17e-6 / 2.04e-6 against Δx = 0.000625 (1.12e-5 / 3.50e-6 against
 /// the Richardson reference; see the end of this comment): every row at or below the paper's.
+/// These runs cut their steps at 50 frame times. With validate's own steps (not cut) ξ = 0.02
+/// ends at 4.45e-5 / 8.20e-6 against Δx = 0.000625 (`validate --full`, 3125 steps, pinch at
+/// t = 0.0219265; the scene a2_dumbbell_quartic_fit_xi0.02.json gives the same steps and
+/// 4.13e-5 / 6.74e-6 against the Richardson reference, every vertex outside, the tips most):
+/// the step sequence moves the just-pinched tips by 1.2e-5 there. ξ = 0.01 with validate's
+/// steps has not been run to t = 0.025 yet (about 2 h 50 min).
 ///
 /// The third column's ξ = 0.04 and 0.02 rows were run after valence-4 vertices stopped using
 /// the interpolating quartic (fitted_mean_curvature_normals(); before: 2.56e-4 / 1.16e-4 and

@@ -458,8 +458,8 @@ void report_a2(std::ostringstream& md, Json& results) {
                   "length): unrefined, the crease vertices lag while the layer in which it "
                   "rounds off is narrower than an edge, the deficit spreads along the handle, "
                   "the neck pinches early and the tips end ahead (ξ = 0.01: vertex L∞ 2.59e-5 "
-                  "from the plain start, above the paper's row; 6.17e-6 from the refined one, "
-                  "in scene runs of this setup).";
+                  "from the plain start, above the paper's row; 6.17e-6 from the refined one; "
+                  "both in runs of this setup that cut their steps at 50 frame times).";
         md << "\n\n"
               "| ξ | steps | triangles | pinch-off time | vertex L∞ | paper L∞ | vertex L1 | "
               "paper L1 | paper's measure: max φ, mean φ | L∞, L1 (sampled) | tips: max φ, "
