@@ -320,8 +320,8 @@ static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::strin
                   << r.crease_vertices << " crease vertices";
             *report = s.str();
         }
-        if (nominal_xi && r.crease_splits > 0)
-            *nominal_xi = r.unrefined_mean_edge_length;
+        if (nominal_xi)
+            *nominal_xi = r.nominal_characteristic_length();
         return mesh;
     }
     const std::string& file = scene.surface.mesh_file;

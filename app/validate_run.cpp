@@ -53,8 +53,8 @@ RunResult run_tracked(const RunSpec& spec, bool quiet) {
     tracker::ImplicitMeshReport mesh_report;
     SurfaceMesh initial = tracker::mesh_implicit_shape(*spec.shape, mesh_options, &mesh_report);
     tracker::TrackerOptions tracker_options = spec.tracker;
-    if (spec.crease.levels > 0 && tracker_options.characteristic_length == 0.0)
-        tracker_options.characteristic_length = mesh_report.unrefined_mean_edge_length;
+    if (tracker_options.characteristic_length == 0.0)
+        tracker_options.characteristic_length = mesh_report.nominal_characteristic_length();
     tracker::SurfaceTracker tr(std::move(initial), tracker_options);
     const SurfaceMesh& mesh = tr.mesh();
     r.xi = tr.characteristic_length();

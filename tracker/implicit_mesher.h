@@ -19,7 +19,7 @@ namespace meniscus::tracker {
 /// √t; sampled at edge_length that rounding starts wrong, and a concave crease lags by a dent
 /// that diffuses into the neighbouring surface. Refined once, the A2 dumbbell's vertex L1 up to
 /// its pinch is 2–3× smaller (app/validate_parameters.h). Give a tracker of the refined mesh the
-/// unrefined ξ (ImplicitMeshReport::unrefined_mean_edge_length,
+/// unrefined ξ (ImplicitMeshReport::nominal_characteristic_length(),
 /// TrackerOptions::characteristic_length), or every size it derives from ξ shrinks too.
 struct CreaseRefinementOptions {
     static constexpr int MAX_LEVELS = 4;  ///< 16× finer than edge_length at most
@@ -51,6 +51,13 @@ struct ImplicitMeshReport {
     double unrefined_mean_edge_length = 0.0;
     int crease_vertices = 0;  ///< crease vertices found before crease refinement
     int crease_splits = 0;    ///< edges split by crease refinement
+
+    /// The ξ to give a tracker of this mesh (TrackerOptions::characteristic_length): the
+    /// unrefined mean edge length when crease refinement split edges, else 0 (the tracker then
+    /// takes the mesh's own mean edge length, which is the same).
+    double nominal_characteristic_length() const {
+        return crease_splits > 0 ? unrefined_mean_edge_length : 0.0;
+    }
 };
 
 /// Meshes `shape`. Throws std::invalid_argument on bad options or an unbounded shape (a

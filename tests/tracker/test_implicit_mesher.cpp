@@ -147,7 +147,8 @@ TEST(ImplicitMesher, CreaseRefinedMeshKeepsItsNominalXiInTheTracker) {
     TrackerOptions tracker;
     EXPECT_DOUBLE_EQ(SurfaceTracker(mesh, tracker).characteristic_length(),
                      edge_length_stats(mesh).mean);  // measured: every size would shrink
-    tracker.characteristic_length = report.unrefined_mean_edge_length;
+    EXPECT_EQ(report.nominal_characteristic_length(), report.unrefined_mean_edge_length);
+    tracker.characteristic_length = report.nominal_characteristic_length();
     EXPECT_DOUBLE_EQ(SurfaceTracker(mesh, tracker).characteristic_length(),
                      report.unrefined_mean_edge_length);
     tracker.characteristic_length = -1.0;
@@ -170,6 +171,7 @@ TEST(ImplicitMesher, CreaseRefinementLeavesASmoothShapeAlone) {
     EXPECT_EQ(report.crease_vertices, 0);  // an edge turns by about 0.13 rad < 0.35
     EXPECT_EQ(report.crease_splits, 0);
     EXPECT_EQ(refined.count_live_triangles(), plain.count_live_triangles());
+    EXPECT_EQ(report.nominal_characteristic_length(), 0.0);  // the tracker measures the mesh
 }
 
 TEST(ImplicitMesher, CreaseOptionsAreValidatedByName) {
