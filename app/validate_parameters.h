@@ -62,14 +62,17 @@ inline constexpr bool MCF_HEUN = true;
 /// These rows now start from a mesh refined once around the dumbbell's crease
 /// (A2_QUARTIC_FIT_DUMBBELL_CREASE_LEVELS): "refit, smoothing ≤ 1" with that start gives
 /// 3.30e-4 / 1.27e-4 (ξ = 0.04) and 2.89e-5 / 6.40e-6 (0.02) against the Richardson reference
-/// below, and at ξ = 0.01 6.17e-6 / 2.04e-6 against Δx = 0.000625 (1.12e-5 / 3.50e-6 against
-/// the Richardson reference; see the end of this comment): every row at or below the paper's.
-/// These runs cut their steps at 50 frame times. With validate's own steps (not cut) ξ = 0.02
-/// ends at 4.45e-5 / 8.20e-6 against Δx = 0.000625 (`validate --full`, 3125 steps, pinch at
-/// t = 0.0219265; the scene a2_dumbbell_quartic_fit_xi0.02.json gives the same steps and
-/// 4.13e-5 / 6.74e-6 against the Richardson reference, every vertex outside, the tips most):
-/// the step sequence moves the just-pinched tips by 1.2e-5 there. ξ = 0.01 with validate's
-/// steps has not been run to t = 0.025 yet (about 2 h 50 min).
+/// below, and at ξ = 0.01 6.17e-6 / 2.04e-6 against Δx = 0.000625 (1.12e-5 / 3.50e-6 against the
+/// Richardson reference; see the end of this comment): every row at or below the paper's. These
+/// runs cut their steps at 50 frame times. With validate's own steps (not cut) ξ = 0.02 ends at
+/// 4.45e-5 / 8.20e-6 against Δx = 0.000625 (`validate --full`, 3125 steps, pinch at t = 0.0219265;
+/// the scene a2_dumbbell_quartic_fit_xi0.02.json gives the same steps and 4.13e-5 / 6.74e-6 against
+/// the Richardson reference, every vertex outside, the tips most): the step sequence moves the
+/// just-pinched tips by 1.2e-5 there. With validate's steps ξ = 0.01 ends at 7.21e-6 / 2.07e-6
+/// against Δx = 0.000625 and 1.23e-5 / 3.53e-6 against the Richardson reference (10265 steps, pinch
+/// between t = 0.021 and 0.022, 0 intersecting pairs; the scene
+/// a2_dumbbell_quartic_fit_xi0.01.json, run to t = 0.002 and continued from its own frame there as
+/// below): at or below the paper's 1.48e-5 / 1.55e-5 with either step sequence.
 ///
 /// The third column's ξ = 0.04 and 0.02 rows were run after valence-4 vertices stopped using
 /// the interpolating quartic (fitted_mean_curvature_normals(); before: 2.56e-4 / 1.16e-4 and
@@ -177,8 +180,9 @@ inline constexpr bool A2_QUARTIC_FIT_DUMBBELL_IN_QUICK = false;
 /// Crease refinement of the quartic-fit dumbbell rows' initial mesh (RunSpec::crease, scene key
 /// surface/crease/levels: edges within 2ξ of the crease halved once, new vertices on the exact
 /// dumbbell; the tracker keeps the unrefined ξ). Above: it brings ξ = 0.01 from 2.59e-5 to 6.17e-6
-/// (vertex L∞ against Δx = 0.000625; paper 1.48e-5) and keeps ξ = 0.04 and 0.02 far below the
-/// paper. Meyer's rows keep the plain start (the paper's setup).
+/// (vertex L∞ against Δx = 0.000625, steps cut at frame times; 7.21e-6 with validate's steps; paper
+/// 1.48e-5) and keeps ξ = 0.04 and 0.02 far below the paper. Meyer's rows keep the plain start (the
+/// paper's setup).
 inline constexpr int A2_QUARTIC_FIT_DUMBBELL_CREASE_LEVELS = 1;
 /// A2 collapses keep the new vertex at the butterfly point, on the smooth surface, instead of
 /// lifting it to keep the volume (RemeshOptions::collapse_preserves_volume): a shrinking shape
