@@ -103,6 +103,10 @@ FluidRunRecord run_sampled(coupling::Simulation& sim, double end_time,
         const coupling::SimulationStepReport s = sim.step(end_time - sim.time());
         ++r.steps;
         r.pressure_converged = r.pressure_converged && s.fluid.pressure.converged;
+        r.viscosity_converged = r.viscosity_converged && s.fluid.viscosity.converged;
+        r.max_passes = std::max(r.max_passes, s.fluid.passes);
+        if (r.steps == 1)
+            r.first_dt = s.dt;
         r.max_intersecting_pairs = std::max(r.max_intersecting_pairs, s.integrate.intersecting_pairs);
         r.merges += s.volume.merges;
         r.splits += s.volume.splits;
@@ -153,6 +157,35 @@ VolumeMoments volume_moments(const tracker::SurfaceMesh& mesh) {
     const Vector3d central = second / volume - c.cwiseProduct(c);
     m.semi_axes = (5.0 * central.cwiseMax(0.0)).cwiseSqrt();
     return m;
+}
+
+Eigen::Vector3d centroid_velocity(const tracker::SurfaceMesh& mesh,
+                                  const std::vector<tracker::Vec3>& velocities) {
+    if (velocities.size() != static_cast<size_t>(mesh.num_vertices()))
+        throw std::invalid_argument("centroid_velocity: one velocity per vertex slot expected");
+    const VolumeMoments m = volume_moments(mesh);
+    if (!(m.volume > 0.0))
+        throw std::invalid_argument("centroid_velocity: the mesh encloses no positive volume");
+    // ∫_T f g dA = A/12 (Σ f_i g_i + Σ f_i Σ g_i) for f, g linear over a triangle of area A.
+    Vector3d sum = Vector3d::Zero();
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti))
+            continue;
+        const auto& tri = mesh.triangle(ti);
+        const Vector3d& p0 = mesh.position(tri[0]);
+        const Vector3d area_normal = 0.5 * (mesh.position(tri[1]) - p0).cross(mesh.position(tri[2]) - p0);
+        Vector3d sum_w = Vector3d::Zero(), sum_wg = Vector3d::Zero();
+        double sum_g = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            const Vector3d w = mesh.position(tri[c]) - m.centroid;
+            const double g = velocities[static_cast<size_t>(tri[c])].dot(area_normal);
+            sum_w += w;
+            sum_g += g;
+            sum_wg += g * w;
+        }
+        sum += (sum_wg + sum_g * sum_w) / 12.0;
+    }
+    return sum / m.volume;
 }
 
 ModeFit column_radius_mode(const tracker::SurfaceMesh& mesh, const Eigen::Vector2d& axis_yz,
@@ -294,18 +327,4 @@ GrowthFit fit_growth_from_rest(const std::vector<double>& t, const std::vector<d
 
 // ---- References -------------------------------------------------------------------------------
 
-double lamb_omega(int l, double sigma, double radius, double rho_inside, double rho_outside) {
-    const double num = l * (l + 1.0) * (l - 1.0) * (l + 2.0) * sigma;
-    const double den = radius * radius * radius * ((l + 1.0) * rho_inside + l * rho_outside);
-    return std::sqrt(num / den);
-}
-
-double rayleigh_plateau_rate(double sigma, double rho, double radius, double k) {
-    const double x = k * radius;
-    if (x >= 1.0)
-        return 0.0;
-    const double w2 = sigma / (rho * radius * radius * radius) * x * (1.0 - x * x) *
-                      std::cyl_bessel_i(1.0, x) / std::cyl_bessel_i(0.0, x);
-    return std::sqrt(w2);
-}
 }  // namespace meniscus::app

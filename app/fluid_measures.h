@@ -1,8 +1,8 @@
 #pragma once
 /// \file Measuring two-phase runs (VALIDATION.md part B; used by `meniscus validate` and the
 /// scene physics tests): coupled runs sampled every step, exact volume moments and Fourier modes
-/// of the mesh, least-squares fits of damped oscillations and of growth from rest, and the
-/// analytic references (Lamb, Rayleigh).
+/// of the mesh, least-squares fits of damped oscillations and of growth from rest. The analytic
+/// references are in fluid_references.h.
 
 #include "app/scene.h"
 #include "coupling/simulation.h"
@@ -27,6 +27,9 @@ struct FluidRunRecord {
     long long steps = 0;
     bool completed = false;      ///< reached the end time
     bool pressure_converged = true;  ///< every pressure solve converged
+    bool viscosity_converged = true;  ///< every viscosity solve converged
+    int max_passes = 0;               ///< most viscous + pressure passes of a step
+    double first_dt = 0.0;            ///< the first step's Δt, s
     int max_intersecting_pairs = 0;
     int merges = 0;
     int splits = 0;
@@ -52,6 +55,14 @@ struct VolumeMoments {
 };
 /// Exact volume integrals over the closed mesh (signed tetrahedra from the origin).
 VolumeMoments volume_moments(const tracker::SurfaceMesh& mesh);
+
+/// Velocity (m/s) of the centroid of the volume a closed mesh encloses when its vertices move
+/// with `velocities` (one per vertex slot, linear over each triangle):
+/// (1/V) ∮ (x − c)(u·n) dA, exact for that piecewise-linear motion. For a drop or bubble this is
+/// its translation speed (the centroid's motion, free of the remeshing noise of differencing
+/// centroids). Throws std::invalid_argument when the sizes differ or the volume is not positive.
+Eigen::Vector3d centroid_velocity(const tracker::SurfaceMesh& mesh,
+                                  const std::vector<tracker::Vec3>& velocities);
 
 /// Fourier mode of a surface: least-squares fit h = mean + a·cos(k(s − s0)) + b·sin(k(s − s0)).
 struct ModeFit {
@@ -96,14 +107,5 @@ struct GrowthFit {
 };
 GrowthFit fit_growth_from_rest(const std::vector<double>& t, const std::vector<double>& y,
                                double rate_min, double rate_max);
-
-// ---- References --------------------------------------------------------------------------------
-
-/// Lamb's inviscid frequency (rad/s) of mode l of a drop of radius R (m), density ρ_i inside and
-/// ρ_o outside: ω² = l(l+1)(l−1)(l+2) σ / (R³ [(l+1) ρ_i + l ρ_o]).
-double lamb_omega(int l, double sigma, double radius, double rho_inside, double rho_outside);
-/// Rayleigh's inviscid growth rate (1/s) of a column of radius R at wavenumber k:
-/// ω² = σ/(ρR³) · x(1−x²) I₁(x)/I₀(x), x = kR (0 for x ≥ 1).
-double rayleigh_plateau_rate(double sigma, double rho, double radius, double k);
 
 }  // namespace meniscus::app

@@ -402,6 +402,60 @@ void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::M
     }
 }
 
+/// The linear solves of a frame's fluid steps.
+struct FrameSolves {
+    long long pressure_iterations = 0, viscosity_iterations = 0, passes = 0;
+    double pressure_residual = 0.0, viscosity_residual = 0.0, pass_change = 0.0;
+    int pressure_failures = 0, viscosity_failures = 0, pass_failures = 0;  ///< steps not converged
+
+    void add(const fluid::StepResult& r) {
+        pressure_iterations += r.pressure.iterations;
+        viscosity_iterations += r.viscosity.iterations;
+        passes += r.passes;
+        pressure_residual = std::max(pressure_residual, r.pressure.residual);
+        viscosity_residual = std::max(viscosity_residual, r.viscosity.residual);
+        pass_change = std::max(pass_change, r.pass_change);
+        pressure_failures += r.pressure.converged ? 0 : 1;
+        viscosity_failures += r.viscosity.converged ? 0 : 1;
+        pass_failures += r.converged_passes ? 0 : 1;
+    }
+
+    nlohmann::json json(long long steps) const {
+        const double n = static_cast<double>(std::max<long long>(steps, 1));
+        return {{"pressure", {{"iterations_per_step", pressure_iterations / n},
+                              {"max_residual", pressure_residual},
+                              {"unconverged_steps", pressure_failures}}},
+                {"viscosity", {{"iterations_per_step", viscosity_iterations / n},
+                               {"max_residual", viscosity_residual},
+                               {"unconverged_steps", viscosity_failures}}},
+                {"viscous_pressure_passes",
+                 {{"per_step", passes / n},
+                  {"max_change", pass_change},
+                  {"unconverged_steps", pass_failures}}}};
+    }
+
+    /// The run-log warning for unconverged solves ("" when every solve converged).
+    std::string warning(int frame, long long steps) const {
+        if (pressure_failures == 0 && viscosity_failures == 0 && pass_failures == 0)
+            return "";
+        std::ostringstream s;
+        s << "warning: frame " << frame << ":";
+        if (pressure_failures > 0)
+            s << " the pressure solve did not converge in " << pressure_failures << " of "
+              << steps << " steps (largest relative residual " << pressure_residual
+              << "; /fluid/pressure_max_iterations, /fluid/pressure_tolerance)";
+        if (viscosity_failures > 0)
+            s << " the viscosity solve did not converge in " << viscosity_failures << " of "
+              << steps << " steps (largest relative residual " << viscosity_residual
+              << "; /fluid/viscosity_max_iterations, /fluid/viscosity_tolerance)";
+        if (pass_failures > 0)
+            s << " the viscous-pressure passes did not settle in " << pass_failures << " of "
+              << steps << " steps (largest change " << pass_change
+              << "; /fluid/viscous_pressure/max_passes)";
+        return s.str();
+    }
+};
+
 nlohmann::json fluid_frame_stats(int frame, double time, long long steps,
                                  const coupling::Simulation& sim,
                                  const coupling::SimulationStepReport& last,
@@ -488,10 +542,12 @@ RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
         long long steps = 0;
         double rasterize = 0.0, fluid_s = 0.0, interpolate = 0.0, tracker_s = 0.0;
         long long intersecting = -1, merges = 0, splits = 0, shortenings = 0;
+        FrameSolves solves;
         while (t < t_frame) {
             if (should_stop(options, stop, t, progress, result))
                 return result;
-            last = sim.step(t_frame - t);
+            last = sim.step(t_frame - t, scene.time.dt);
+            solves.add(last.fluid);
             rasterize += last.rasterize_seconds;
             fluid_s += last.fluid_seconds;
             interpolate += last.interpolate_seconds;
@@ -517,7 +573,13 @@ RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
                                        {{"intersecting_pairs", intersecting},
                                         {"merges", merges},
                                         {"splits", splits},
-                                        {"step_shortenings", shortenings}}));
+                                        {"step_shortenings", shortenings},
+                                        {"solves", solves.json(steps)}}));
+        const std::string warning = solves.warning(frame, steps);
+        if (!warning.empty() && !options.quiet) {
+            progress.finish();
+            std::fprintf(stderr, "%s\n", warning.c_str());
+        }
         result.frames_written = frame + 1;
         result.simulated_time = t;
         char detail[128];

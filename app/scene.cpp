@@ -92,9 +92,38 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
                "pressure Poisson solver");
     v.number("pressure_tolerance", o.pressure.iteration.tolerance, Range{0.0, 1.0, true, true}, "",
              "relative residual of the pressure solve");
+    v.integer("pressure_max_iterations", o.pressure.iteration.max_iterations,
+              Range::between(1, 100000), "", "PCG iterations before a pressure solve gives up");
+    v.number("viscosity_tolerance", o.viscosity.iteration.tolerance, Range{0.0, 1.0, true, true},
+             "", "relative residual of the implicit viscosity solve");
+    enum_field(v, "viscosity_weights", o.viscosity.weights,
+               {{"sharp", fluid::ViscosityWeights::sharp},
+                {"volume_fraction", fluid::ViscosityWeights::volume_fraction}},
+               "two_phase μ next to the interface: `sharp` (cell phase, harmonic mean on edges) "
+               "or `volume_fraction` (blended by the liquid fraction of each control volume)");
+    v.integer("viscosity_max_iterations", o.viscosity.iteration.max_iterations,
+              Range::between(1, 100000), "", "CG iterations before a viscosity solve gives up");
+    v.section("viscous_pressure", "how the viscous and pressure solves are coupled in a step",
+              [&](auto& r) {
+                  enum_field(r, "coupling", o.viscous_pressure.coupling,
+                             {{"coupled", fluid::ViscousPressureCoupling::coupled},
+                              {"incremental", fluid::ViscousPressureCoupling::incremental},
+                              {"split", fluid::ViscousPressureCoupling::split}},
+                             "`coupled`: rotational pressure increment repeated to the "
+                             "backward-Euler Stokes step; `incremental`: previous pressure in the "
+                             "viscous solve (exact steady states); `split`: viscosity, then "
+                             "projection (steady states depend on the time step)");
+                  r.integer("max_passes", o.viscous_pressure.max_passes, Range::between(1, 100),
+                            "", "coupled: most viscous + pressure passes per step");
+                  r.number("pass_tolerance", o.viscous_pressure.pass_tolerance,
+                           Range{0.0, 1.0, true, true}, "",
+                           "coupled: largest velocity change between passes over the largest "
+                           "speed at which the passes stop");
+              });
     v.number("cfl_number", o.time_step.cfl_number, Range::positive(), "cells",
              "cells a fluid particle may cross per step");
-    v.number("max_dt", o.time_step.max_dt, Range::positive(), "s", "upper bound on the time step");
+    v.number("max_dt", o.time_step.max_dt, Range::positive(), "s",
+             "upper bound on the fluid's time step (/time/dt caps it too)");
 }
 
 template <typename V>
@@ -251,7 +280,8 @@ void visit_fields(V& v, TimeOptions& o) {
     v.integer("frames", o.frames, Range::between(1, 1000000), "",
               "frames after the initial one, evenly spaced in time");
     v.number("dt", o.dt, Range::positive(), "s",
-             "maximum time step (shortened to land exactly on frame times)");
+             "maximum time step (shortened to land exactly on frame times); fluid scenes take the "
+             "smaller of it and /fluid/max_dt");
     v.boolean("land_on_frames", o.land_on_frames,
               "shorten steps to end exactly on frame times; false (geometric flows only): a frame "
               "is written after the first step that reaches its time, so the steps are those of "

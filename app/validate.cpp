@@ -568,7 +568,7 @@ void check_validate_options(const ValidateOptions& options) {
     for (const std::string& id : options.cases)
         if (!is_fluid_case(id) && id != "A1" && id != "A2" && id != "A3" && id != "A4")
             throw std::invalid_argument("validate: unknown case '" + id +
-                                        "' (expected A1, A2, A3, A4 or B1 … B5)");
+                                        "' (expected A1, A2, A3, A4 or B1 … B7)");
     for (const std::string& name : options.curvature_operators)
         if (name != "cotangent" && name != "quartic_fit")
             throw std::invalid_argument("validate: unknown curvature operator '" + name +

@@ -1,4 +1,4 @@
-/// Part B of `meniscus validate`: two-phase flow with surface tension (VALIDATION.md B1–B5); the
+/// Part B of `meniscus validate`: two-phase flow with surface tension (docs/validation.md B1–B5; B6–B7 in validate_viscous.cpp); the
 /// plots are in validate_fluid_plots.cpp.
 /// B1–B4 drive a coupling::Simulation step by step and measure the mesh after every step
 /// (app/fluid_measures.h); B5 runs the shipped merge and pinch scenes through run_scene() exactly
@@ -8,7 +8,10 @@
 #include "app/validate_fluid.h"
 
 #include "app/fluid_measures.h"
+#include "app/fluid_references.h"
 #include "app/run.h"
+#include "app/validate_fluid_common.h"
+#include "app/validate_viscous.h"
 
 #include <algorithm>
 #include <atomic>
@@ -23,7 +26,7 @@ namespace meniscus::app {
 
 namespace {
 
-using Json = nlohmann::json;
+using namespace validate_fluid;
 using Clock = std::chrono::steady_clock;
 using Eigen::Vector3d;
 
@@ -31,20 +34,11 @@ double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::string fmt(double v, const char* f = "%.4g") {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, f, v);
-    return buf;
-}
-
-std::string percent(double measured, double reference) {
-    return fmt(100.0 * (measured / reference - 1.0), "%+.2f %%");
-}
-
 }  // namespace
 
 bool is_fluid_case(const std::string& id) {
-    return id == "B1" || id == "B2" || id == "B3" || id == "B4" || id == "B5";
+    return id == "B1" || id == "B2" || id == "B3" || id == "B4" || id == "B5" || id == "B6" ||
+           id == "B7";
 }
 
 // ---- The cases ----------------------------------------------------------------------------------
@@ -81,61 +75,7 @@ constexpr double B5_VOLUME_TOLERANCE = 0.005;
 /// B1: pressure samples this many cells away from the interface.
 constexpr double B1_WELL_CELLS = 3.0;
 
-Json base_scene(const std::string& name) {
-    return {{"name", name},
-            {"flow", {{"type", "fluid"}}},
-            {"fluid", {{"gravity", {0, 0, 0}}, {"mode", "two_phase"}}},
-            {"coupling", {{"edge_length_cells", 1.0}, {"volume_correction", true}}},
-            {"output", {{"ply", false}, {"vdb", false}}}};
-}
-
-Scene scene_from(const Json& j) { return parse_scene(j.dump(), j["name"].get<std::string>(), "."); }
-
-Json series_json(const FluidRunRecord& r) {
-    return {{"t", r.t},
-            {"components", r.components},
-            {"enclosed_volume", r.enclosed_volume},
-            {"max_speed", r.max_speed}};
-}
-
-Json run_summary(const FluidRunRecord& r) {
-    return {{"steps", r.steps},
-            {"completed", r.completed},
-            {"pressure_converged", r.pressure_converged},
-            {"max_intersecting_pairs", r.max_intersecting_pairs},
-            {"wall_seconds", r.wall_seconds}};
-}
-
-double max_relative_drift(const std::vector<double>& v) {
-    double drift = 0.0;
-    for (double x : v)
-        drift = std::max(drift, std::abs(x / v.front() - 1.0));
-    return drift;
-}
-
-struct Runner {
-    const FluidValidationOptions& options;
-    FluidValidation& out;
-
-    void log(const std::string& line) const {
-        if (!options.quiet)
-            std::fprintf(stderr, "  %s\n", line.c_str());
-    }
-
-    void check(const std::string& what, const FluidRunRecord& r) {
-        std::string why;
-        if (!r.completed)
-            why = "did not reach its end time";
-        else if (r.max_intersecting_pairs > 0)
-            why = "intersecting triangle pairs";
-        else if (!r.pressure_converged)
-            why = "a pressure solve did not converge";
-        if (!why.empty()) {
-            out.all_ok = false;
-            out.failures.push_back(what + ": " + why);
-        }
-    }
-
+struct Runner : CaseContext {
     // ---- B1 ----
     void b1(std::ostringstream& md) {
         const std::vector<int> resolutions =
@@ -682,13 +622,13 @@ struct Runner {
 
 FluidValidation run_fluid_validation(const FluidValidationOptions& options) {
     FluidValidation out;
-    Runner runner{options, out};
+    Runner runner{{options, out}};
     const auto wanted = [&](const char* id) {
         return options.cases.empty() ||
                std::find(options.cases.begin(), options.cases.end(), id) != options.cases.end();
     };
     std::ostringstream md;
-    md << "# Part B — two-phase flow with surface tension (VALIDATION.md B1–B5)\n\n"
+    md << "# Part B — two-phase flow with surface tension (docs/validation.md B1–B7)\n\n"
        << (options.full ? "Full variants." : "Quick variants: coarse and short (test suite); "
                                              "`meniscus validate --full` runs the resolutions "
                                              "VALIDATION.md asks for.")
@@ -703,6 +643,10 @@ FluidValidation run_fluid_validation(const FluidValidationOptions& options) {
         runner.b4(md);
     if (wanted("B5"))
         runner.b5(md);
+    if (wanted("B6"))
+        viscous_drop_case(runner, md);
+    if (wanted("B7"))
+        creeping_bubble_case(runner, md);
     out.report = md.str();
     return out;
 }

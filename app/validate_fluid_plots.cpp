@@ -118,6 +118,66 @@ if "B5" in b:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     save(fig, "b5_volume.png")
+
+def study_panel(ax, study, label, target):
+    """|error| against the reference per resolution, one line per dt factor (log-log)."""
+    factors = sorted({r["dt_factor"] for row in study["rows"] for r in row["runs"]}, reverse=True)
+    for f in factors:
+        xs, ys = [], []
+        for row in study["rows"]:
+            for r in row["runs"]:
+                if r["dt_factor"] == f:
+                    xs.append(row["resolution"])
+                    ys.append(max(abs(r["relative_error"]) * 100, 1e-3))
+        name = "own dt" if f == 1 else "dt/%g" % (1 / f)
+        ax.loglog(xs, ys, "o-", ms=4, label="%s, %s" % (study["quantity"], name))
+    ax.axhline(100 * target, color="k", ls=":", lw=1, label="target %g %%" % (100 * target))
+    ax.set_xlabel(label)
+    ax.set_ylabel("|error| (%)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+
+if "B6" in b:
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.5))
+    B6 = b["B6"]
+    w, g = B6["omega_exact"], B6["decay_rate_exact"]
+    for r in B6["runs"]:
+        s = r["series"]
+        t, d = s["t"], s["deformation"]
+        lbl = "%d cells per D, dt factor %g" % (r["cells_per_diameter"], r["dt_factor"])
+        ax.plot([1e3 * x for x in t], [1e3 * y for y in d], ".", ms=2, label=lbl)
+    r0 = B6["runs"][0]
+    t = r0["series"]["t"]
+    a0 = r0["series"]["deformation"][0] - r0["offset"]
+    ax.plot([1e3 * x for x in t], [1e3 * (r0["offset"] + a0 * math.exp(-g * x) * math.cos(w * x)) for x in t],
+            "k:", lw=1, label="exact mode: w = %.1f, g = %.1f 1/s" % (w, g))
+    ax.set_xlabel("t (ms)")
+    ax.set_ylabel("a_x - (a_y + a_z)/2 (mm)")
+    ax.set_title("B6 viscous drop (l = 2)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    study_panel(bx, B6["frequency"], "cells per diameter", 0.05)
+    study_panel(bx, B6["damping"], "cells per diameter", 0.05)
+    bx.set_title("B6 errors against the exact mode")
+    save(fig, "b6_viscous_drop.png")
+
+if "B7" in b:
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.5))
+    B7 = b["B7"]
+    for r in B7["runs"]:
+        s = r["series"]
+        ax.plot([1e3 * x for x in s["speed_t"]], [1e3 * u for u in s["speed"]], "-", lw=1,
+                label="%d cells per D, dt factor %g" % (r["cells_per_diameter"], r["dt_factor"]))
+        ax.axhline(1e3 * r["reference_speed"], color="k", ls=":", lw=1)
+    ax.plot([], [], "k:", label="Hadamard-Rybczynski, wall-corrected")
+    ax.set_xlabel("t (ms)")
+    ax.set_ylabel("rise speed (mm/s)")
+    ax.set_title("B7 creeping bubble")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    study_panel(bx, B7["speed"], "cells per diameter", 0.05)
+    bx.set_title("B7 rise speed error")
+    save(fig, "b7_creeping_bubble.png")
 )PY";
 
 }  // namespace
@@ -126,7 +186,7 @@ std::string make_fluid_plots(const std::filesystem::path& out) {
     if (!run_plot_script(out, "plot_fluid.py", PLOT_SCRIPT, "plot_fluid_errors.txt"))
         return "**Part B plots failed** (see plot_fluid_errors.txt).";
     return "Part B plots: b1_spurious.png, b2_oscillation.png, b3_growth.png, b4_wave.png, "
-           "b5_volume.png (for the cases run).";
+           "b5_volume.png, b6_viscous_drop.png, b7_creeping_bubble.png (for the cases run).";
 }
 
 }  // namespace meniscus::app

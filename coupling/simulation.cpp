@@ -58,9 +58,9 @@ Simulation::Simulation(tracker::SurfaceTracker tracker, fluid::FluidSolver fluid
                                tracker::Vec3::Zero());
 }
 
-SimulationStepReport Simulation::step(double max_dt) {
-    if (!(max_dt > 0.0))
-        throw std::invalid_argument("Simulation::step: max_dt must be > 0");
+SimulationStepReport Simulation::step(double time_left, double max_dt) {
+    if (!(time_left > 0.0) || !(max_dt > 0.0))
+        throw std::invalid_argument("Simulation::step: time_left and max_dt must be > 0");
     SimulationStepReport report;
     tracker::SurfaceMesh& mesh = m_tracker->mesh();
     const fluid::MacGrid& grid = m_fluid.grid();
@@ -86,7 +86,8 @@ SimulationStepReport Simulation::step(double max_dt) {
     };
     bind(limits.cfl, StepLimit::cfl);
     bind(capillary, StepLimit::capillary);
-    bind(max_dt, StepLimit::frame_end);
+    bind(max_dt, StepLimit::max_dt);
+    bind(time_left, StepLimit::frame_end);
 
     // (2) Mesh → grid.
     auto start = Clock::now();

@@ -14,6 +14,7 @@
 #include "fluid/fluid_solver.h"
 #include "tracker/surface_tracker.h"
 
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -57,8 +58,12 @@ public:
     Simulation(tracker::SurfaceTracker tracker, fluid::FluidSolver fluid,
                const SimulationOptions& options);
 
-    /// Advances by one step of at most `max_dt` (s), e.g. the time left to the next frame.
-    SimulationStepReport step(double max_dt);
+    /// Advances by one step of at most `time_left` (s, the time left to the next frame; reported
+    /// as StepLimit::frame_end when it binds) and at most `max_dt` (s, a scene's largest step;
+    /// reported, like the fluid's own TimeStepOptions::max_dt, as StepLimit::max_dt). Throws
+    /// std::invalid_argument unless both are > 0.
+    SimulationStepReport step(double time_left,
+                              double max_dt = std::numeric_limits<double>::infinity());
 
     const tracker::SurfaceTracker& tracker() const { return *m_tracker; }
     const fluid::FluidSolver& fluid() const { return m_fluid; }

@@ -1,5 +1,6 @@
 #include "fluid/fluid_solver.h"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -21,6 +22,29 @@ const FluidOptions& validated(const FluidOptions& options) {
     return options;
 }
 
+/// Coupled scheme: a velocity of this many cells per step counts as rest when the divergence
+/// left by the viscous solve is measured against the flow's speed.
+constexpr double RESTING_CELLS_PER_STEP = 1e-12;
+
+/// Subtracts the mean over the pressure system's unknown cells (all cells in two_phase, liquid
+/// cells in free_surface) from `pressure` on those cells.
+void remove_unknown_mean(const InterfaceInput& interface, FluidMode mode,
+                         Array3<double>& pressure) {
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t c = 0; c < pressure.size(); ++c)
+        if (mode == FluidMode::two_phase || is_liquid(interface.phi[c])) {
+            sum += pressure[c];
+            ++count;
+        }
+    if (count == 0)
+        return;
+    const double mean = sum / static_cast<double>(count);
+    for (std::size_t c = 0; c < pressure.size(); ++c)
+        if (mode == FluidMode::two_phase || is_liquid(interface.phi[c]))
+            pressure[c] -= mean;
+}
+
 }  // namespace
 
 void FluidOptions::validate() const {
@@ -36,6 +60,7 @@ void FluidOptions::validate() const {
     viscosity.validate();
     pressure.validate();
     time_step.validate();
+    viscous_pressure.validate();
     if (extrapolation_layers < 0) {
         throw std::invalid_argument("FluidOptions.extrapolation_layers must be non-negative");
     }
@@ -58,11 +83,29 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
     m_grid.zero_wall_normal_velocity();
     result.timings.advection = seconds_since(start);
 
+    if (m_options.viscous_pressure.coupling == ViscousPressureCoupling::split) {
+        split_step(dt, interface, result);
+    } else {
+        incremental_step(dt, interface, result);
+    }
+
+    if (m_options.mode == FluidMode::free_surface) {
+        start = Clock::now();
+        extrapolate_velocity(m_grid, interface, m_options.extrapolation_layers);
+        result.timings.extrapolation = seconds_since(start);
+    }
+    m_was_liquid = liquid_cells(interface.phi);
+    result.timings.total = seconds_since(step_start);
+    return result;
+}
+
+void FluidSolver::split_step(double dt, const InterfaceInput& interface, StepResult& result) {
     // Viscosity before gravity: the body force is then balanced by the pressure of the same
     // projection, so a fluid at rest in hydrostatic equilibrium stays exactly at rest.
-    start = Clock::now();
+    Clock::time_point start = Clock::now();
     result.viscosity = m_viscosity.solve(m_grid, interface, m_options.phases, m_options.mode,
-                                         m_options.walls, dt, m_options.viscosity);
+                                         m_options.walls, dt, m_options.viscosity,
+                                         m_options.pressure.min_liquid_fraction);
     result.timings.viscosity = seconds_since(start);
 
     start = Clock::now();
@@ -75,14 +118,150 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
     result.pressure = projection.solve;
     result.max_divergence = projection.max_divergence;
     result.timings.pressure = seconds_since(start);
+}
 
-    if (m_options.mode == FluidMode::free_surface) {
-        start = Clock::now();
-        extrapolate_velocity(m_grid, interface, m_options.extrapolation_layers);
-        result.timings.extrapolation = seconds_since(start);
+void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
+                                   StepResult& result) {
+    const PhaseOptions& phases = m_options.phases;
+    const FluidMode mode = m_options.mode;
+    const ViscousPressureOptions& scheme = m_options.viscous_pressure;
+    const bool viscous = m_options.viscosity.enabled &&
+                         (phases.mu_liquid > 0.0 ||
+                          (mode == FluidMode::two_phase && phases.mu_gas > 0.0));
+    // Without viscosity the projection alone already is the coupled step.
+    const int max_iterations =
+        scheme.coupling == ViscousPressureCoupling::coupled && viscous ? scheme.max_passes : 0;
+    // The increment carries no jump: G_J p⁽ⁿ⁾ already holds it (and the free-surface value σκ).
+    PhaseOptions increment_phases = phases;
+    increment_phases.sigma = 0.0;
+    const auto add_solve = [](SolveResult& total, const SolveResult& one) {
+        total.converged = total.converged && one.converged;
+        total.iterations += one.iterations;
+        total.residual = std::max(total.residual, one.residual);
+    };
+    result.viscosity.converged = true;
+    result.pressure.converged = true;
+
+    // Momentum with the previous pressure: u = A⁻¹(ρ/Δt u_a + ρ g − G_J p⁽ⁿ⁾).
+    Clock::time_point start = Clock::now();
+    if (m_was_liquid.empty()) {
+        // No previous pressure: start from the one that balances the body force and the jump
+        // (hydrostatic plus Laplace), so that rest is exact from the first step.
+        MacGrid body(m_grid.nx(), m_grid.ny(), m_grid.nz(), m_grid.dx(), m_grid.origin());
+        apply_gravity(body, m_options.gravity, dt);
+        add_solve(result.pressure, project(body, interface, phases, mode, dt,
+                                           m_options.pressure, m_pressure)
+                                       .solve);
     }
-    result.timings.total = seconds_since(step_start);
-    return result;
+    carry_pressure_to_new_phase(m_was_liquid, interface, phases, mode, m_pressure);
+    apply_gravity(m_grid, m_options.gravity, dt);
+    apply_pressure_gradient(m_grid, interface, phases, mode, dt, m_options.pressure, m_pressure);
+    if (mode == FluidMode::free_surface) {
+        // Gas faces took the body force but no pressure: give them the liquid's velocity again,
+        // or the viscous solve would drag the liquid along with them (rest would not be exact).
+        extrapolate_velocity(m_grid, interface, m_options.extrapolation_layers);
+    }
+    result.timings.forces += seconds_since(start);
+    start = Clock::now();
+    add_solve(result.viscosity,
+              m_viscosity.solve(m_grid, interface, phases, mode, m_options.walls, dt,
+                                m_options.viscosity, m_options.pressure.min_liquid_fraction));
+    result.timings.viscosity += seconds_since(start);
+
+    if (max_iterations > 0) {
+        // Uzawa–PCG on T δ = −D u, T = Gᵀ A⁻¹ G: u ← u + V(δ) with V(δ) = −A⁻¹ G δ the viscous
+        // solve of the velocity impulse −Δt/ρ G δ, so the residual is always −D u.
+        start = Clock::now();
+        const double dx = m_grid.dx();
+        std::vector<double> r = unknown_divergence(m_grid, interface, mode);
+        for (double& x : r)
+            x = -x;
+        // The velocity scale: the flow's, the body force's over the step, or (at rest without
+        // gravity) a displacement of RESTING_CELLS_PER_STEP cells per step.
+        const double velocity_floor = std::max(m_options.gravity.norm() * dt,
+                                               RESTING_CELLS_PER_STEP * dx / dt);
+        const auto divergence_ratio = [&]() {
+            double largest = 0.0;
+            for (double x : r)
+                largest = std::max(largest, std::abs(x));
+            const double speed = std::max(m_grid.max_abs_velocity().maxCoeff(), velocity_floor);
+            return largest * dx / speed;
+        };
+        result.pass_change = divergence_ratio();
+        result.converged_passes = result.pass_change <= scheme.pass_tolerance;
+        PressureSystem system;
+        std::vector<double> z, q;
+        Array3<double> direction;
+        MacGrid impulse(1, 1, 1, dx);
+        double rz = 0.0;
+        if (!result.converged_passes) {
+            system = build_pressure_system(m_grid, interface, increment_phases, mode, dt,
+                                           m_options.pressure);
+            add_solve(result.pressure, apply_cahouet_chabard(system, m_options.pressure,
+                                                             interface, phases, mode, dt, dx, r,
+                                                             z));
+            direction.resize(m_grid.nx(), m_grid.ny(), m_grid.nz(), 0.0);
+            direction.storage() = z;
+            rz = dot(r, z);
+            impulse = MacGrid(m_grid.nx(), m_grid.ny(), m_grid.nz(), dx, m_grid.origin());
+        }
+        result.timings.pressure += seconds_since(start);
+        for (int iteration = 0; iteration < max_iterations && !result.converged_passes;
+             ++iteration) {
+            start = Clock::now();
+            for (int axis = 0; axis < 3; ++axis)
+                impulse.velocity(axis).fill(0.0);
+            apply_pressure_gradient(impulse, interface, increment_phases, mode, dt,
+                                    m_options.pressure, direction);
+            add_solve(result.viscosity,
+                      m_viscosity.solve(impulse, interface, phases, mode, m_options.walls, dt,
+                                        m_options.viscosity,
+                                        m_options.pressure.min_liquid_fraction));
+            result.timings.viscosity += seconds_since(start);
+            start = Clock::now();
+            q = unknown_divergence(impulse, interface, mode);  // T s
+            const double curvature = dot(direction.storage(), q);
+            if (!(curvature > 0.0))
+                break;  // breakdown (inexact inner solves): the projection below still applies
+            const double alpha = rz / curvature;
+            for (int axis = 0; axis < 3; ++axis) {
+                std::vector<double>& u = m_grid.velocity(axis).storage();
+                const std::vector<double>& w = impulse.velocity(axis).storage();
+                for (std::size_t f = 0; f < u.size(); ++f)
+                    u[f] += alpha * w[f];
+            }
+            for (std::size_t c = 0; c < r.size(); ++c) {
+                m_pressure[c] += alpha * direction[c];
+                r[c] -= alpha * q[c];
+            }
+            ++result.passes;
+            result.pass_change = divergence_ratio();
+            result.converged_passes = result.pass_change <= scheme.pass_tolerance;
+            if (!result.converged_passes) {
+                add_solve(result.pressure,
+                          apply_cahouet_chabard(system, m_options.pressure, interface, phases,
+                                                mode, dt, dx, r, z));
+                const double rz_new = dot(r, z);
+                const double beta = rz_new / rz;
+                rz = rz_new;
+                for (std::size_t c = 0; c < r.size(); ++c)
+                    direction[c] = z[c] + beta * direction[c];
+            }
+            result.timings.pressure += seconds_since(start);
+        }
+    }
+
+    // The projection of what is left: u divergence-free to the pressure solver's tolerance.
+    start = Clock::now();
+    const ProjectionResult projection = project(m_grid, interface, increment_phases, mode, dt,
+                                                m_options.pressure, m_increment);
+    for (std::size_t c = 0; c < m_pressure.size(); ++c)
+        m_pressure[c] += m_increment[c];
+    if (projection.singular)
+        remove_unknown_mean(interface, mode, m_pressure);
+    add_solve(result.pressure, projection.solve);
+    result.max_divergence = projection.max_divergence;
+    result.timings.pressure += seconds_since(start);
 }
 
 TimeStepLimits FluidSolver::time_step_limits() const {

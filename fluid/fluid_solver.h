@@ -17,6 +17,7 @@
 #include "fluid/solve_result.h"
 #include "fluid/timestep.h"
 #include "fluid/viscosity.h"
+#include "fluid/viscous_pressure.h"
 
 namespace meniscus::fluid {
 
@@ -29,6 +30,7 @@ struct FluidOptions {
     AdvectionOptions advection;
     ViscosityOptions viscosity;
     PressureOptions pressure;
+    ViscousPressureOptions viscous_pressure;  ///< how viscosity and pressure are coupled
     TimeStepOptions time_step;
     int extrapolation_layers = 4;  ///< free_surface: face layers filled into the void (≥ 0)
 
@@ -48,9 +50,18 @@ struct StepTimings {
 
 /// What a step did.
 struct StepResult {
-    SolveResult pressure;         ///< pressure Poisson solve
-    SolveResult viscosity;        ///< viscous CG solve (0 iterations when skipped)
+    /// Pressure Poisson solves of the step: converged = every pass's did, iterations summed over
+    /// the passes, residual the largest.
+    SolveResult pressure;
+    SolveResult viscosity;        ///< viscous CG solves, summed likewise (0 iterations: skipped)
     double max_divergence = 0.0;  ///< max |∇·u| over the solved cells after projection, 1/s
+    /// coupled: Uzawa–PCG iterations of the step (0 for the other schemes and for inviscid
+    /// flow); pass_change: the largest |D u|·Δx after them (before the final projection) over
+    /// the velocity scale (the largest face speed, at least |g|Δt); converged_passes: it met
+    /// ViscousPressureOptions::pass_tolerance.
+    int passes = 0;
+    double pass_change = 0.0;
+    bool converged_passes = true;
     StepTimings timings;
 };
 
@@ -63,9 +74,10 @@ public:
                 const FluidOptions& options);
 
     /// Advances the velocity by `dt` seconds (> 0) with the interface `interface` (sized for the
-    /// grid): advect, viscosity, gravity, projection, extrapolation (free_surface). Gravity comes
-    /// after viscosity so that hydrostatic rest is an exact steady state of the step.
-    /// Numerical non-convergence is reported in the result, not thrown.
+    /// grid): advection, then viscosity, gravity and pressure coupled as
+    /// FluidOptions::viscous_pressure says (viscous_pressure.h), then extrapolation
+    /// (free_surface). Hydrostatic rest is an exact steady state of every scheme. Numerical
+    /// non-convergence is reported in the result, not thrown.
     StepResult step(double dt, const InterfaceInput& interface);
 
     /// The time-step limits for the current velocity (CFL, viscous, capillary).
@@ -74,15 +86,23 @@ public:
     MacGrid& grid() { return m_grid; }
     const MacGrid& grid() const { return m_grid; }
     /// Pressure (Pa) at cell centres from the last step, nx × ny × nz; zero in the void
-    /// (free_surface); mean zero when the system is pure Neumann (two_phase).
+    /// (free_surface); mean zero when the system is pure Neumann (two_phase). The incremental
+    /// and coupled schemes start the next step from it.
     const Array3<double>& pressure() const { return m_pressure; }
     const FluidOptions& options() const { return m_options; }
 
 private:
+    /// Viscosity, gravity and projection of the split scheme.
+    void split_step(double dt, const InterfaceInput& interface, StepResult& result);
+    /// The incremental and coupled schemes.
+    void incremental_step(double dt, const InterfaceInput& interface, StepResult& result);
+
     FluidOptions m_options;
     MacGrid m_grid;
     Array3<double> m_pressure;
+    Array3<double> m_increment;  ///< scratch: the projection's pressure increment δ
     ViscositySolver m_viscosity;
+    std::vector<char> m_was_liquid;  ///< liquid flags of the last step's cells (empty at first)
 };
 
 }  // namespace meniscus::fluid

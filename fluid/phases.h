@@ -25,6 +25,10 @@ struct PhaseOptions {
     void validate() const;
 };
 
+/// Default lower clamp of a face's liquid fraction θ where the free surface crosses it (the
+/// ghost-fluid Dirichlet coefficient β/θ and the viscous face inertia ρθ).
+constexpr double DEFAULT_MIN_LIQUID_FRACTION = 1.0e-3;
+
 /// Density (kg/m³) of a face whose segment between the two adjacent cell centres is a fraction
 /// `liquid_fraction` ∈ [0, 1] in the liquid: θ ρ_l + (1 − θ) ρ_g (Liu–Fedkiw–Kang: the
 /// harmonic mean of the face coefficients 1/ρ weighted by θ). In free_surface mode: ρ_l.

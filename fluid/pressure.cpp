@@ -190,9 +190,10 @@ SolveResult solve_pressure_system(const PressureSystem& system, const PressureOp
 
 void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
                              const PhaseOptions& phases, FluidMode mode, double dt,
-                             const PressureOptions& options, const Array3<double>& pressure) {
+                             const PressureOptions& options, const Array3<double>& pressure,
+                             double factor) {
     const Array3<double>& phi = interface.phi;
-    const double scale = dt / grid.dx();
+    const double scale = factor * dt / grid.dx();
     for (int axis = 0; axis < 3; ++axis) {
         Array3<double>& velocity = grid.velocity(axis);
         const Array3<double>& kappa = interface.kappa(axis);
@@ -240,6 +241,7 @@ ProjectionResult project(MacGrid& grid, const InterfaceInput& interface, const P
     const PressureSystem system = build_pressure_system(grid, interface, phases, mode, dt, options);
     ProjectionResult result;
     result.solve = solve_pressure_system(system, options, pressure);
+    result.singular = system.singular;
     apply_pressure_gradient(grid, interface, phases, mode, dt, options, pressure);
     result.max_divergence = max_fluid_divergence(grid, interface, mode);
     return result;

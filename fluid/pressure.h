@@ -37,7 +37,8 @@ enum class PressureSolver {
 struct PressureOptions {
     PressureSolver solver = PressureSolver::multigrid_pcg;
     IterativeSolverOptions iteration;     ///< relative residual tolerance and iteration cap
-    double min_liquid_fraction = 1.0e-3;  ///< lower clamp of θ for free-surface ghost faces, (0, 1]
+    /// Lower clamp of θ for free-surface ghost faces, (0, 1] (the viscous solve uses the same).
+    double min_liquid_fraction = DEFAULT_MIN_LIQUID_FRACTION;
     Mic0Options mic0;
     MultigridOptions multigrid;
 
@@ -64,11 +65,13 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
 SolveResult solve_pressure_system(const PressureSystem& system, const PressureOptions& options,
                                   Array3<double>& pressure);
 
-/// u ← u − Δt/ρ_f ∇p on every face adjacent to an unknown cell (ghost-fluid gradients with the
-/// σκ jump; free-surface faces use the interface Dirichlet value). Wall faces are untouched.
+/// u ← u − factor · Δt/ρ_f ∇p on every face adjacent to an unknown cell (ghost-fluid gradients
+/// with the σκ jump; free-surface faces use the interface Dirichlet value σκ). Wall faces are
+/// untouched. `factor` 1 is the projection's update; −1 adds the same impulse back.
 void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
                              const PhaseOptions& phases, FluidMode mode, double dt,
-                             const PressureOptions& options, const Array3<double>& pressure);
+                             const PressureOptions& options, const Array3<double>& pressure,
+                             double factor = 1.0);
 
 /// Largest |∇·u| (1/s) over the unknown cells of the pressure system (all cells in two_phase,
 /// liquid cells in free_surface).
@@ -78,6 +81,7 @@ double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface
 struct ProjectionResult {
     SolveResult solve;            ///< linear solve outcome
     double max_divergence = 0.0;  ///< max |∇·u| over unknown cells after projection, 1/s
+    bool singular = false;        ///< the system was pure Neumann (p only up to a constant)
 };
 
 /// Full projection: build, solve, apply the gradient. `pressure` receives p (Pa).

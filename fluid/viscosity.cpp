@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <memory>
@@ -33,7 +34,8 @@ class ViscousOperator {
 public:
     /// (Re)builds the operator for a grid, interface and time step, reusing the arrays' memory.
     void build(const MacGrid& grid, const Array3<double>& phi, const PhaseOptions& phases,
-               FluidMode mode, const WallOptions& walls, double dt) {
+               FluidMode mode, const WallOptions& walls, double dt, double min_liquid_fraction,
+               ViscosityWeights weights) {
         m_n = {grid.nx(), grid.ny(), grid.nz()};
         m_dx = grid.dx();
         m_dt = dt;
@@ -50,13 +52,17 @@ public:
             m_normal_stress[a].resize(m_n[0], m_n[1], m_n[2], 0.0);
         }
         m_size = offset;
-        const double mu_gas = mode == FluidMode::two_phase ? phases.mu_gas : 0.0;
         m_mu.resize(m_n[0], m_n[1], m_n[2]);
+        m_fraction_weights = mode == FluidMode::free_surface ||
+                             weights == ViscosityWeights::volume_fraction;
+        m_mu_gas = mode == FluidMode::two_phase ? phases.mu_gas : 0.0;
         for (std::size_t c = 0; c < m_mu.size(); ++c) {
-            m_mu[c] = is_liquid(phi[c]) ? phases.mu_liquid : mu_gas;
+            m_mu[c] = m_fraction_weights
+                          ? blended_mu(phases.mu_liquid, control_volume_fraction(phi[c]))
+                          : (is_liquid(phi[c]) ? phases.mu_liquid : m_mu_gas);
         }
-        set_edge_weights(walls);
-        set_faces(phi, phases, mode);
+        set_edge_weights(walls, phi, phases);
+        set_faces(phi, phases, mode, min_liquid_fraction);
     }
 
     std::size_t size() const { return m_size; }
@@ -156,7 +162,19 @@ private:
                    (static_cast<std::size_t>(f[1]) + static_cast<std::size_t>(d[1]) * f[2]);
     }
 
-    void set_edge_weights(const WallOptions& walls) {
+    /// Liquid fraction of a cube of edge dx centred where the level set is `phi`: exact for a
+    /// plane parallel to a face, 1 and 0 a half cell inside and outside (free_surface weights).
+    double control_volume_fraction(double phi) const {
+        return std::clamp(HALF - phi / m_dx, 0.0, 1.0);
+    }
+
+    /// μ of a control volume whose liquid fraction is `fraction`.
+    double blended_mu(double mu_liquid, double fraction) const {
+        return m_mu_gas + (mu_liquid - m_mu_gas) * fraction;
+    }
+
+    void set_edge_weights(const WallOptions& walls, const Array3<double>& phi,
+                          const PhaseOptions& phases) {
         for (int c = 0; c < 3; ++c) {
             const int a = (c + 1) % 3;
             const int b = (c + 2) % 3;
@@ -177,9 +195,33 @@ private:
                         if (free_slip) {
                             continue;  // zero shear stress on a free-slip wall
                         }
+                        if (m_fraction_weights) {
+                            // Batty & Bridson 2008: the shear term weighted by the liquid
+                            // fraction of the edge's control volume (φ at the edge: the mean of
+                            // its cells), so a traction-free surface sits where φ = 0, not on
+                            // the cell faces next to the void.
+                            double phi_sum = 0.0;
+                            int count = 0;
+                            for (int da = -1; da <= 0; ++da) {
+                                for (int db = -1; db <= 0; ++db) {
+                                    Index3 cell = e;
+                                    cell[a] += da;
+                                    cell[b] += db;
+                                    if (phi.contains(cell[0], cell[1], cell[2])) {
+                                        phi_sum += phi(cell[0], cell[1], cell[2]);
+                                        ++count;
+                                    }
+                                }
+                            }
+                            weight(i, j, k) =
+                                SHEAR_WEIGHT * fraction *
+                                blended_mu(phases.mu_liquid,
+                                           control_volume_fraction(phi_sum / count));
+                            continue;
+                        }
                         // Harmonic mean of the (up to 4) cells around the edge: exact for the
                         // shear stress across a layer interface through the edge; 0 next to a
-                        // cell with μ = 0 (the traction-free void of free_surface mode).
+                        // cell with μ = 0.
                         double inverse_sum = 0.0;
                         int count = 0;
                         bool inviscid = false;
@@ -205,7 +247,8 @@ private:
         }
     }
 
-    void set_faces(const Array3<double>& phi, const PhaseOptions& phases, FluidMode mode) {
+    void set_faces(const Array3<double>& phi, const PhaseOptions& phases, FluidMode mode,
+                   double min_liquid_fraction) {
         m_unknown.assign(m_size, 0);
         m_density.assign(m_size, 0.0);
         for (int a = 0; a < 3; ++a) {
@@ -218,7 +261,11 @@ private:
                     return;
                 }
                 m_unknown[flat] = 1;
-                m_density[flat] = face_density(liquid_fraction(phi_lo, phi_hi), phases, mode);
+                const double theta = liquid_fraction(phi_lo, phi_hi);
+                m_density[flat] =
+                    mode == FluidMode::free_surface
+                        ? phases.rho_liquid * std::max(theta, min_liquid_fraction)
+                        : face_density(theta, phases, mode);
             });
         }
     }
@@ -318,6 +365,8 @@ private:
     std::array<std::size_t, 3> m_offset{};
     std::size_t m_size = 0;
     Array3<double> m_mu;                          ///< μ per cell
+    bool m_fraction_weights = false;              ///< μ blended by control-volume fractions
+    double m_mu_gas = 0.0;                        ///< 0 in free_surface mode
     std::array<Array3<double>, 3> m_edge_weight;  ///< W_e per edge, by the axis it is parallel to
     std::vector<char> m_unknown;                  ///< 1 on faces that are solved for
     std::vector<double> m_density;                ///< ρ_f on unknown faces
@@ -329,6 +378,8 @@ private:
 
 void ViscosityOptions::validate() const {
     iteration.validate();
+    if (weights != ViscosityWeights::sharp && weights != ViscosityWeights::volume_fraction)
+        throw std::invalid_argument("ViscosityOptions.weights: unknown weighting");
 }
 
 /// Work arrays kept between ViscositySolver::solve calls.
@@ -345,7 +396,8 @@ ViscositySolver& ViscositySolver::operator=(ViscositySolver&&) noexcept = defaul
 SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interface,
                                    const PhaseOptions& phases, FluidMode mode,
                                    const WallOptions& walls, double dt,
-                                   const ViscosityOptions& options) {
+                                   const ViscosityOptions& options,
+                                   double min_liquid_fraction) {
     options.validate();
     walls.validate();
     interface.validate(grid);
@@ -360,7 +412,7 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     }
     Workspace& ws = *m_workspace;
     ViscousOperator& op = ws.op;
-    op.build(grid, interface.phi, phases, mode, walls, dt);
+    op.build(grid, interface.phi, phases, mode, walls, dt, min_liquid_fraction, options.weights);
     const std::vector<char>& unknown = op.unknown();
     const std::vector<double>& density = op.density();
     const std::size_t n = op.size();
@@ -430,9 +482,10 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
 
 SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
                             const PhaseOptions& phases, FluidMode mode, const WallOptions& walls,
-                            double dt, const ViscosityOptions& options) {
+                            double dt, const ViscosityOptions& options,
+                            double min_liquid_fraction) {
     ViscositySolver solver;
-    return solver.solve(grid, interface, phases, mode, walls, dt, options);
+    return solver.solve(grid, interface, phases, mode, walls, dt, options, min_liquid_fraction);
 }
 
 }  // namespace meniscus::fluid

@@ -17,7 +17,14 @@
 /// velocity is mirrored with opposite sign (zero at the wall) and the edge terms on that wall are
 /// weighted by the half of their dual cell inside the box; on a free-slip wall the shear stress
 /// vanishes, so the edge terms lying on that wall are dropped. In free_surface mode only
-/// faces next to a liquid cell are unknowns and the gas has μ = 0 (traction-free surface).
+/// faces next to a liquid cell are unknowns, the gas has μ = 0, and μ_c and μ_e are μ_liquid
+/// times the liquid fraction of their control volume (a cube of edge Δx around the cell centre
+/// or edge midpoint, clamp(½ − φ/Δx, 0, 1) with φ there; Batty & Bridson 2008), so the surface
+/// is traction-free where φ = 0 rather than on the faces of the last liquid cells; other faces
+/// these terms touch keep their (extrapolated) velocity. A face the surface crosses has the
+/// inertia ρ_l θ (θ its liquid fraction, clamped below by `min_liquid_fraction`), as the
+/// pressure's ghost-fluid coefficient 1/(ρ_l θ): the projection's velocity impulse and the
+/// viscous solve then see the same face mass, which keeps the coupled step symmetric.
 
 #include <memory>
 
@@ -28,10 +35,22 @@
 
 namespace meniscus::fluid {
 
+/// How μ is weighted next to the two_phase interface.
+enum class ViscosityWeights {
+    /// μ_c of the cell's phase; μ_e the harmonic mean of the (up to 4) cells around the edge.
+    sharp,
+    /// μ_c and μ_e blended by the liquid fraction V of their control volume (a cube of edge Δx,
+    /// V = clamp(½ − φ/Δx, 0, 1) with φ at its centre): μ_g + (μ_l − μ_g) V (Batty & Bridson
+    /// 2008's volume-weighted energy).
+    volume_fraction
+};
+
 /// Options of the implicit viscosity step.
 struct ViscosityOptions {
     bool enabled = true;               ///< false skips the step (inviscid flow)
     IterativeSolverOptions iteration;  ///< CG tolerance and iteration cap
+    /// two_phase weights at the interface (free_surface always uses the liquid fraction).
+    ViscosityWeights weights = ViscosityWeights::sharp;
 
     /// Throws std::invalid_argument naming the field when out of range.
     void validate() const;
@@ -43,7 +62,8 @@ struct ViscosityOptions {
 /// grid or dt ≤ 0. Allocates its work arrays on every call; see ViscositySolver to reuse them.
 SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
                             const PhaseOptions& phases, FluidMode mode, const WallOptions& walls,
-                            double dt, const ViscosityOptions& options);
+                            double dt, const ViscosityOptions& options,
+                            double min_liquid_fraction = DEFAULT_MIN_LIQUID_FRACTION);
 
 /// The same solve as apply_viscosity(), keeping its work arrays (operator coefficients, CG
 /// vectors) between calls so repeated steps on one grid do not reallocate. Movable, not copyable;
@@ -58,7 +78,8 @@ public:
     /// See apply_viscosity().
     SolveResult solve(MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,
                       FluidMode mode, const WallOptions& walls, double dt,
-                      const ViscosityOptions& options);
+                      const ViscosityOptions& options,
+                      double min_liquid_fraction = DEFAULT_MIN_LIQUID_FRACTION);
 
 private:
     struct Workspace;

@@ -231,6 +231,24 @@ TEST_F(CliTest, RunWritesEveryFrameAndStats) {
         EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
 }
 
+TEST_F(CliTest, UnconvergedViscousSolveIsWarnedAbout) {
+    // Issue 34: a viscous or pressure solve that does not converge is said in the run log.
+    const std::string scene = write("drop.json", R"({
+  "flow": {"type": "fluid"},
+  "domain": {"min": [0, 0, 0], "size": [0.006, 0.006, 0.006], "cells": 12},
+  "fluid": {"gravity": [0, 0, 0], "viscosity_max_iterations": 1, "viscosity_tolerance": 1e-12},
+  "surface": {"shape": {"type": "sphere", "center": [0.003, 0.003, 0.003], "radius": 0.0015}},
+  "time": {"end": 0.0005, "frames": 1},
+  "output": {"ply": false, "vdb": false}
+})");
+    const Outcome o = run_meniscus("run " + scene + " --out " + (m_dir / "out").string());
+    ASSERT_EQ(o.exit_code, 0) << o.output;
+    EXPECT_NE(o.output.find("warning: frame 1: the viscosity solve did not converge"),
+              std::string::npos)
+        << o.output;
+    EXPECT_NE(o.output.find("/fluid/viscosity_max_iterations"), std::string::npos) << o.output;
+}
+
 TEST_F(CliTest, FramesOptionOverridesTheSceneKeepingTimePerFrame) {
     const std::string scene = write("small.json", SMALL_SCENE);
     const fs::path out = m_dir / "out";

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 
 namespace meniscus::app {
@@ -104,6 +105,68 @@ std::vector<nlohmann::json> read_stats(const fs::path& dir) {
     for (std::string line; std::getline(stats, line);)
         lines.push_back(nlohmann::json::parse(line));
     return lines;
+}
+
+/// The static drop for `frames` frames with `edit` applied to the scene.
+std::vector<nlohmann::json> static_drop_stats(int frames, const std::function<void(Scene&)>& edit,
+                                              const std::string& dir_name) {
+    Scene scene = load_scene(std::string(MENISCUS_SOURCE_DIR) + "/scenes/static_drop.json");
+    scene.output.vdb = false;
+    scene.output.ply = false;
+    edit(scene);
+    RunOptions options;
+    options.out_dir = (fs::temp_directory_path() / dir_name).string();
+    options.frames = frames;
+    options.quiet = true;
+    const std::atomic<bool> stop{false};
+    run_scene(scene, options, stop);
+    std::vector<nlohmann::json> lines = read_stats(options.out_dir);
+    fs::remove_all(options.out_dir);
+    return lines;
+}
+
+TEST(FluidScenes, TimeDtCapsTheFluidStep) {
+    // Issue 34: /time/dt was documented as the largest step but fluid scenes ignored it.
+    Scene reference = load_scene(std::string(MENISCUS_SOURCE_DIR) + "/scenes/static_drop.json");
+    const double frame = reference.time.end / reference.time.frames;
+    const std::vector<nlohmann::json> free = static_drop_stats(1, [](Scene&) {}, "meniscus_dt_a");
+    ASSERT_EQ(free.size(), 2u);
+    const double own_dt = free[1]["dt"];
+    EXPECT_NE(free[1]["dt_limit"], "max_dt");
+    const double cap = 0.25 * own_dt;
+    const std::vector<nlohmann::json> capped =
+        static_drop_stats(1, [&](Scene& s) { s.time.dt = cap; }, "meniscus_dt_b");
+    ASSERT_EQ(capped.size(), 2u);
+    EXPECT_LE(capped[1]["dt"].get<double>(), cap * (1.0 + 1e-12));
+    EXPECT_GE(capped[1]["steps"].get<long long>(), static_cast<long long>(frame / cap));
+}
+
+TEST(FluidScenes, StatsReportTheViscousAndPressureSolves) {
+    const std::vector<nlohmann::json> lines =
+        static_drop_stats(1, [](Scene&) {}, "meniscus_solves");
+    ASSERT_EQ(lines.size(), 2u);
+    const nlohmann::json& solves = lines[1]["solves"];
+    EXPECT_GT(solves["pressure"]["iterations_per_step"].get<double>(), 0.0);
+    EXPECT_GT(solves["viscosity"]["iterations_per_step"].get<double>(), 0.0);
+    EXPECT_EQ(solves["pressure"]["unconverged_steps"], 0);
+    EXPECT_EQ(solves["viscosity"]["unconverged_steps"], 0);
+    EXPECT_LE(solves["viscosity"]["max_residual"].get<double>(), 1e-6);
+    EXPECT_TRUE(solves.contains("viscous_pressure_passes"));
+}
+
+TEST(FluidScenes, UnconvergedSolvesAreCountedInTheStats) {
+    // One viscous CG iteration cannot reach 1e-12: every step is counted as unconverged (and
+    // `meniscus run` warns; the CLI test checks the message).
+    const std::vector<nlohmann::json> lines = static_drop_stats(
+        1,
+        [](Scene& s) {
+            s.fluid.viscosity.iteration.max_iterations = 1;
+            s.fluid.viscosity.iteration.tolerance = 1e-12;
+        },
+        "meniscus_unconverged");
+    ASSERT_EQ(lines.size(), 2u);
+    EXPECT_EQ(lines[1]["solves"]["viscosity"]["unconverged_steps"].get<long long>(),
+              lines[1]["steps"].get<long long>());
 }
 
 const std::string FLOW_SCENES = std::string(MENISCUS_SOURCE_DIR) + "/scenes/flows/";

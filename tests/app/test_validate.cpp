@@ -97,6 +97,20 @@ constexpr double B3_QUICK_RATE_RELATIVE = 0.10;
 constexpr double B4_QUICK_FREQUENCY_RELATIVE = 0.08;
 /// An oscillation fit must describe the run: rms residual below this fraction of the amplitude.
 constexpr double FIT_RMS_FRACTION = 0.05;
+/// B6 viscous drop (ω₀R²/ν = 20) at 12 cells per diameter against the exact free-drop mode:
+/// measured ω −1.7 %, γ −3.8 % at the solver's own Δt, −1.9 % / −3.7 % at Δt/2.
+constexpr double B6_QUICK_FREQUENCY_RELATIVE = 0.04;
+constexpr double B6_QUICK_DAMPING_RELATIVE = 0.08;
+/// The coupled step's answer does not move with Δt (the split step's would, by the viscous
+/// diffusion number): own Δt against Δt/2.
+constexpr double B6_DT_CHANGE_RELATIVE = 0.01;
+/// B7 creeping bubble at 8 cells per diameter in a 6-radius free-slip box: measured +18.9 %
+/// against the wall-corrected Hadamard–Rybczynski speed (the spatial error at 8 cells per
+/// diameter; the split step gave +480 % at the same Δt, diffusion number 11).
+constexpr double B7_QUICK_SPEED_RELATIVE = 0.25;
+constexpr double B7_DT_CHANGE_RELATIVE = 0.02;
+/// Steady by the end: the last quarter's mean speed against the quarter before.
+constexpr double B7_STEADY_RELATIVE = 0.01;
 
 class QuickValidation : public ::testing::Test {
 protected:
@@ -340,6 +354,51 @@ TEST_F(QuickValidation, PartBMergeSceneKeepsPhaseVolumes) {
         EXPECT_NE(s_report.find(heading), std::string::npos) << heading;
     EXPECT_NE(s_report.find("| cells per D | steps | fitted period (ms) | Lamb (ms)"),
               std::string::npos);
+}
+
+TEST_F(QuickValidation, PartBViscousDropHasTheExactModeAtEveryTimeStep) {
+    const Json& b6 = s_results["part_b"]["B6"];
+    const Json& runs = b6["runs"];
+    ASSERT_EQ(runs.size(), 2u);  // own Δt and Δt/2
+    const double omega = b6["omega_exact"].get<double>(), gamma = b6["decay_rate_exact"].get<double>();
+    for (const Json& r : runs) {
+        SCOPED_TRACE("dt factor " + r["dt_factor"].dump());
+        EXPECT_TRUE(r["completed"].get<bool>());
+        EXPECT_EQ(r["max_intersecting_pairs"].get<int>(), 0);
+        EXPECT_LT(std::abs(r["omega"].get<double>() / omega - 1.0), B6_QUICK_FREQUENCY_RELATIVE);
+        EXPECT_LT(std::abs(r["decay_rate"].get<double>() / gamma - 1.0), B6_QUICK_DAMPING_RELATIVE);
+        EXPECT_LT(r["rms_residual"].get<double>(), FIT_RMS_FRACTION * r["amplitude"].get<double>());
+        EXPECT_LT(r["volume_drift"].get<double>(), 0.005);
+    }
+    EXPECT_LT(std::abs(runs[1]["omega"].get<double>() / runs[0]["omega"].get<double>() - 1.0),
+              B6_DT_CHANGE_RELATIVE);
+    EXPECT_LT(std::abs(runs[1]["decay_rate"].get<double>() / runs[0]["decay_rate"].get<double>() -
+                       1.0),
+              2.0 * B6_DT_CHANGE_RELATIVE);
+    EXPECT_NE(s_report.find("## B6"), std::string::npos);
+    EXPECT_TRUE(fs::exists(s_out / "b6_viscous_drop.png"));
+}
+
+TEST_F(QuickValidation, PartBCreepingBubbleRisesAtTheReferenceSpeedAtItsOwnTimeStep) {
+    const Json& b7 = s_results["part_b"]["B7"];
+    const Json& runs = b7["runs"];
+    ASSERT_EQ(runs.size(), 2u);  // own Δt and Δt/2
+    for (const Json& r : runs) {
+        SCOPED_TRACE("dt factor " + r["dt_factor"].dump());
+        EXPECT_TRUE(r["completed"].get<bool>());
+        EXPECT_EQ(r["max_intersecting_pairs"].get<int>(), 0);
+        const double u = r["rise_speed"].get<double>();
+        EXPECT_LT(std::abs(u / r["reference_speed"].get<double>() - 1.0), B7_QUICK_SPEED_RELATIVE);
+        EXPECT_LT(std::abs(r["rise_speed_previous_quarter"].get<double>() / u - 1.0),
+                  B7_STEADY_RELATIVE);
+    }
+    // The solver's own Δt is at viscous diffusion number ≈ 11 in the liquid.
+    EXPECT_GT(runs[0]["diffusion_number"].get<double>(), 5.0);
+    EXPECT_LT(std::abs(runs[1]["rise_speed"].get<double>() / runs[0]["rise_speed"].get<double>() -
+                       1.0),
+              B7_DT_CHANGE_RELATIVE);
+    EXPECT_NE(s_report.find("## B7"), std::string::npos);
+    EXPECT_TRUE(fs::exists(s_out / "b7_creeping_bubble.png"));
 }
 
 TEST(ValidateOptionsCheck, NamesTheXiNoSelectedCaseRunsAndTheOnesTheyDo) {

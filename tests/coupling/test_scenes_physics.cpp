@@ -7,6 +7,7 @@
 #include "app/run.h"
 #include "app/scene.h"
 #include "app/fluid_measures.h"
+#include "app/fluid_references.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

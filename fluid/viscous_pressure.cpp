@@ -1,0 +1,147 @@
+#include "fluid/viscous_pressure.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+namespace meniscus::fluid {
+
+namespace {
+
+constexpr std::array<std::array<int, 3>, 6> NEIGHBOURS = {
+    {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}}};
+
+/// κ on the face between cell (i, j, k) and its neighbour `n` (index into NEIGHBOURS).
+double face_kappa(const InterfaceInput& interface, int i, int j, int k, int n) {
+    const int axis = n / 2;
+    const bool upper = n % 2 == 1;
+    std::array<int, 3> f = {i, j, k};
+    if (upper)
+        ++f[axis];
+    return interface.kappa(axis)(f[0], f[1], f[2]);
+}
+
+}  // namespace
+
+void ViscousPressureOptions::validate() const {
+    if (coupling != ViscousPressureCoupling::split &&
+        coupling != ViscousPressureCoupling::incremental &&
+        coupling != ViscousPressureCoupling::coupled)
+        throw std::invalid_argument("ViscousPressureOptions.coupling: unknown scheme");
+    if (max_passes < 1)
+        throw std::invalid_argument("ViscousPressureOptions.max_passes must be at least 1");
+    if (!(pass_tolerance > 0.0 && pass_tolerance < 1.0))
+        throw std::invalid_argument("ViscousPressureOptions.pass_tolerance must be in (0, 1)");
+}
+
+std::vector<char> liquid_cells(const Array3<double>& phi) {
+    std::vector<char> liquid(phi.size());
+    for (std::size_t c = 0; c < phi.size(); ++c)
+        liquid[c] = is_liquid(phi[c]) ? 1 : 0;
+    return liquid;
+}
+
+void carry_pressure_to_new_phase(const std::vector<char>& was_liquid,
+                                 const InterfaceInput& interface, const PhaseOptions& phases,
+                                 FluidMode mode, Array3<double>& pressure) {
+    if (was_liquid.empty())
+        return;
+    const Array3<double>& phi = interface.phi;
+    if (was_liquid.size() != phi.size() || pressure.size() != phi.size())
+        throw std::invalid_argument(
+            "carry_pressure_to_new_phase: was_liquid, pressure and phi differ in size");
+    const Array3<double> old = pressure;
+    for (int k = 0; k < phi.nk(); ++k)
+        for (int j = 0; j < phi.nj(); ++j)
+            for (int i = 0; i < phi.ni(); ++i) {
+                const std::size_t c = phi.index(i, j, k);
+                const bool liquid = is_liquid(phi[c]);
+                if (liquid == (was_liquid[c] != 0))
+                    continue;
+                double sum = 0.0, kappa = 0.0;
+                int count = 0;
+                bool crossed = false;
+                for (int n = 0; n < 6; ++n) {
+                    const int a = i + NEIGHBOURS[n][0], b = j + NEIGHBOURS[n][1],
+                              d = k + NEIGHBOURS[n][2];
+                    if (!phi.contains(a, b, d))
+                        continue;
+                    const std::size_t m = phi.index(a, b, d);
+                    const bool neighbour_liquid = is_liquid(phi[m]);
+                    if (neighbour_liquid == liquid && (was_liquid[m] != 0) == liquid) {
+                        sum += old[m];
+                        ++count;
+                    } else if (neighbour_liquid != liquid && !crossed) {
+                        kappa = face_kappa(interface, i, j, k, n);
+                        crossed = true;
+                    }
+                }
+                if (count > 0) {
+                    pressure[c] = sum / count;
+                } else if (mode == FluidMode::two_phase) {
+                    // p_liquid − p_gas = σκ.
+                    pressure[c] = old[c] + (liquid ? 1.0 : -1.0) * phases.sigma * kappa;
+                } else {
+                    pressure[c] = liquid ? phases.sigma * kappa : 0.0;
+                }
+            }
+}
+
+SolveResult apply_cahouet_chabard(const PressureSystem& system, const PressureOptions& options,
+                           const InterfaceInput& interface, const PhaseOptions& phases,
+                           FluidMode mode, double dt, double dx, const std::vector<double>& r,
+                           std::vector<double>& z) {
+    PressureSystem scaled = system;
+    const double scale = dx * dx / dt;
+    for (std::size_t c = 0; c < r.size(); ++c)
+        scaled.rhs[c] = system.matrix.diag[c] > 0.0 ? scale * r[c] : 0.0;
+    Array3<double> poisson;
+    const SolveResult solve = solve_pressure_system(scaled, options, poisson);
+    const double mu_gas = mode == FluidMode::two_phase ? phases.mu_gas : 0.0;
+    z.assign(r.size(), 0.0);
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t c = 0; c < r.size(); ++c) {
+        if (!(system.matrix.diag[c] > 0.0))
+            continue;
+        const double mu = is_liquid(interface.phi[c]) ? phases.mu_liquid : mu_gas;
+        z[c] = poisson[c] + 2.0 * mu * r[c];
+        sum += z[c];
+        ++count;
+    }
+    if (system.singular && count > 0) {
+        const double mean = sum / static_cast<double>(count);
+        for (std::size_t c = 0; c < r.size(); ++c)
+            if (system.matrix.diag[c] > 0.0)
+                z[c] -= mean;
+    }
+    return solve;
+}
+
+std::vector<double> unknown_divergence(const MacGrid& grid, const InterfaceInput& interface,
+                                       FluidMode mode) {
+    const Array3<double>& phi = interface.phi;
+    std::vector<double> divergence(phi.size(), 0.0);
+    for (int k = 0; k < phi.nk(); ++k)
+        for (int j = 0; j < phi.nj(); ++j)
+            for (int i = 0; i < phi.ni(); ++i)
+                if (mode == FluidMode::two_phase || is_liquid(phi(i, j, k)))
+                    divergence[phi.index(i, j, k)] = grid.divergence(i, j, k);
+    return divergence;
+}
+
+double max_velocity_difference(const MacGrid& a, const MacGrid& b) {
+    double largest = 0.0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::vector<double>& x = a.velocity(axis).storage();
+        const std::vector<double>& y = b.velocity(axis).storage();
+        if (x.size() != y.size())
+            throw std::invalid_argument("max_velocity_difference: grids differ in size");
+        for (std::size_t f = 0; f < x.size(); ++f)
+            largest = std::max(largest, std::abs(x[f] - y[f]));
+    }
+    return largest;
+}
+
+}  // namespace meniscus::fluid
