@@ -133,6 +133,9 @@ void visit_fields(V& v, SurfaceOptions& o) {
                  "an edge whose end normals turn by more than this crosses a crease");
         r.number("band", o.crease.band, Range::non_negative(), "m",
                  "refine within this distance of a crease (0 = twice edge_length)");
+        r.boolean("snap", o.crease.snap,
+                  "before refining, move vertices onto the creases and flip edges to run along "
+                  "them (sharp edges become mesh edges instead of chamfers; needs angle < π/2)");
     });
     v.boolean("open", o.open,
               "the mesh_file is an open surface with boundary edges (paper §4.4; geometric flows "
@@ -594,7 +597,7 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
             throw SceneError("/time/land_on_frames: fluid scenes always land on frame times");
         if (scene.surface.open && scene.shape)
             throw SceneError("/surface/open: only a mesh_file can be open (shapes are closed)");
-        if (scene.surface.crease.levels > 0 && !scene.shape)
+        if ((scene.surface.crease.levels > 0 || scene.surface.crease.snap) && !scene.shape)
             throw SceneError(
                 "/surface/crease/levels: crease refinement needs a `shape` (it "
                 "moves new vertices onto the exact surface)");
