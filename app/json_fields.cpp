@@ -153,6 +153,44 @@ void JsonReader::vec3(const char* key, Eigen::Vector3d& value, Range range, cons
     value = v;
 }
 
+void JsonReader::text3(const char* key, std::array<std::string, 3>& value, const char*) {
+    const nlohmann::json* j = lookup(key);
+    if (!j)
+        return;
+    const std::string expected = "expected an array of 3 strings (or numbers)";
+    if (!j->is_array() || j->size() != 3)
+        fail(key, expected + ", got " + type_name(*j) +
+                      (j->is_array() ? " of " + std::to_string(j->size()) : ""));
+    std::array<std::string, 3> v;
+    for (size_t i = 0; i < 3; ++i) {
+        const auto& c = (*j)[i];
+        if (c.is_string())
+            v[i] = c.get<std::string>();
+        else if (c.is_number())
+            v[i] = c.dump();  // nlohmann writes doubles so that they read back exactly
+        else
+            fail(std::string(key) + "/" + std::to_string(i),
+                 "expected a string or a number, got " + type_name(c));
+    }
+    value = v;
+}
+
+void JsonReader::number_map(const char* key, std::map<std::string, double>& value, const char*,
+                            const char*) {
+    const nlohmann::json* j = lookup(key);
+    if (!j)
+        return;
+    if (!j->is_object())
+        fail(key, "expected an object of named numbers, got " + type_name(*j));
+    std::map<std::string, double> v;
+    for (auto it = j->begin(); it != j->end(); ++it) {
+        if (!it->is_number() || !std::isfinite(it->get<double>()))
+            fail(std::string(key) + "/" + it.key(), "expected a number, got " + type_name(*it));
+        v[it.key()] = it->get<double>();
+    }
+    value = v;
+}
+
 void JsonReader::finish() const {
     for (auto it = m_object.begin(); it != m_object.end(); ++it) {
         if (m_known.count(it.key()) == 0) {
@@ -200,6 +238,19 @@ void ReferenceWriter::vec3(const char* key, Eigen::Vector3d& value, Range range,
          "[" + format_number(value.x()) + ", " + format_number(value.y()) + ", " +
              format_number(value.z()) + "]",
          unit, meaning});
+}
+
+void ReferenceWriter::text3(const char* key, std::array<std::string, 3>& value,
+                            const char* meaning) {
+    add({key, "3 strings", "[\"" + value[0] + "\", \"" + value[1] + "\", \"" + value[2] + "\"]", "",
+         meaning});
+}
+void ReferenceWriter::number_map(const char* key, std::map<std::string, double>& value,
+                                 const char* unit, const char* meaning) {
+    std::string text;
+    for (const auto& [name, v] : value)
+        text += (text.empty() ? "" : ", ") + ("\"" + name + "\": " + format_number(v));
+    add({key, "object of numbers", "{" + text + "}", unit, meaning});
 }
 
 std::string ReferenceWriter::markdown(const std::vector<Table>& tables) {

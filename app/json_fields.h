@@ -8,7 +8,9 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -53,6 +55,12 @@ public:
                 const char* meaning);
     void vec3(const char* key, Eigen::Vector3d& value, Range range, const char* unit,
               const char* meaning);
+    /// An array of 3 texts; a number stands for its own text (e.g. the expressions of
+    /// /flow/expression/velocity, where 0 means "0").
+    void text3(const char* key, std::array<std::string, 3>& value, const char* meaning);
+    /// An object of named numbers, e.g. {"omega": 6.28}; replaces `value`.
+    void number_map(const char* key, std::map<std::string, double>& value, const char* unit,
+                    const char* meaning);
     /// Visits a nested section with `visit(JsonReader&)` if the key is present.
     template <typename Visit>
     void section(const char* key, const char* meaning, Visit&& visit) {
@@ -101,6 +109,9 @@ public:
                 const char* meaning);
     void vec3(const char* key, Eigen::Vector3d& value, Range range, const char* unit,
               const char* meaning);
+    void text3(const char* key, std::array<std::string, 3>& value, const char* meaning);
+    void number_map(const char* key, std::map<std::string, double>& value, const char* unit,
+                    const char* meaning);
     template <typename Visit>
     void section(const char* key, const char* meaning, Visit&& visit) {
         add({key, "object", "", "", std::string(meaning) + " (see " + m_path + "/" + key + ")"});

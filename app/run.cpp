@@ -65,11 +65,16 @@ struct GeometricFlow {
 GeometricFlow make_flow(const FlowOptions& flow) {
     // "fluid" scenes never get here (run_fluid_scene).
     GeometricFlow g;
-    if (flow.type == "enright" || flow.type == "curl_noise") {
+    if (flow.type == "enright" || flow.type == "curl_noise" || flow.type == "rigid" ||
+        flow.type == "expression") {
         if (flow.type == "enright")
             g.field = std::make_unique<tracker::EnrightField>(flow.period);
-        else
+        else if (flow.type == "curl_noise")
             g.field = std::make_unique<tracker::CurlNoiseField>(flow.curl_noise);
+        else if (flow.type == "rigid")
+            g.field = std::make_unique<tracker::RigidMotionField>(flow.rigid);
+        else
+            g.field = std::make_unique<tracker::ExpressionField>(flow.expression);
         g.stepper = std::make_unique<tracker::VelocityFieldStepper>(*g.field);
     } else if (flow.type == "normal_speed") {
         const NormalSpeedOptions& n = flow.normal_speed;
@@ -90,6 +95,18 @@ GeometricFlow make_flow(const FlowOptions& flow) {
     return g;
 }
 
+/// One step of a geometric flow. A user's field that is not finite where the surface is
+/// (/flow/expression: ExpressionField throws std::domain_error) is a scene error.
+tracker::FlowStep flow_step(const tracker::FlowStepper& stepper, const SurfaceMesh& mesh, double t,
+                            double dt, const Scene& scene) {
+    try {
+        return stepper.step(mesh, t, dt);
+    } catch (const std::domain_error& e) {
+        throw InputError(scene.source_path + ": /flow/expression/" + e.what() +
+                         ": the field must be finite wherever the surface goes");
+    }
+}
+
 /// /flow/exact: the error of the surface against an exact solution, per frame.
 class ExactSolution {
 public:
@@ -97,6 +114,7 @@ public:
     ExactSolution(const Scene& scene, double end_time)
         : m_options(scene.flow.exact),
           m_two_spheres(two_sphere_normal_flow(scene, end_time)),
+          m_rigid(scene.flow.rigid),
           m_source(scene.source_path) {}
 
     bool enabled() const { return m_options.type != "none"; }
@@ -104,6 +122,8 @@ public:
     /// Throws InputError if the run ends after the exact surface vanishes (the scene's own end
     /// time is checked when it is read; --frames can extend it).
     void check_end(double end_time) const {
+        if (m_options.type == "rigid_motion")
+            return;  // never vanishes
         const double vanishes =
             m_options.type == "two_sphere_normal_flow"
                 ? m_two_spheres.reversal_time +
@@ -123,7 +143,12 @@ public:
     /// Throws InputError unless the initial surface is the exact solution at t = 0: every vertex
     /// within INITIAL_VERTEX_TOLERANCE · ξ of it and the enclosed volume within
     /// INITIAL_VOLUME_TOLERANCE of the exact one (so that, say, one sphere of the two fails).
-    void check_initial(const SurfaceMesh& mesh, double xi) const {
+    /// rigid_motion: the initial surface is its own exact solution; it is kept for stats().
+    void check_initial(const SurfaceMesh& mesh, double xi) {
+        if (m_options.type == "rigid_motion") {
+            m_initial = mesh;
+            return;
+        }
         const tracker::SurfaceError e = error(mesh, 0.0);
         const double volume = tracker::enclosed_volume(mesh), exact = initial_volume();
         if (e.vertex_linf <= INITIAL_VERTEX_TOLERANCE * xi &&
@@ -139,6 +164,8 @@ public:
 
     /// The stats.jsonl entry at time t.
     nlohmann::json stats(const SurfaceMesh& mesh, double t) const {
+        if (m_options.type == "rigid_motion")
+            return rigid_motion_stats(mesh, t);
         const tracker::SurfaceError e = error(mesh, t);
         nlohmann::json j = {{"type", m_options.type},
                             {"linf", e.linf},
@@ -155,6 +182,26 @@ private:
     static constexpr double INITIAL_VERTEX_TOLERANCE = 1e-2;
     /// Relative volume slack: a polyhedron inscribed in a sphere loses about ℓ²/(4R²).
     static constexpr double INITIAL_VOLUME_TOLERANCE = 0.05;
+
+    /// rigid_motion: the initial mesh carried by the exact rigid map to time t against the
+    /// surface, both ways (tracker::hausdorff_distance): `linf`/`l1` are the surface's distances
+    /// from the exact one, `hausdorff` the larger of the two one-sided maxima.
+    nlohmann::json rigid_motion_stats(const SurfaceMesh& mesh, double t) const {
+        SurfaceMesh exact = m_initial;
+        for (int vi = 0; vi < exact.num_vertices(); ++vi)
+            if (exact.vertex_alive(vi))
+                exact.set_position(vi, m_rigid.position(exact.position(vi), t));
+        const tracker::HausdorffDistance h =
+            tracker::hausdorff_distance(mesh, exact, m_options.sampling);
+        return {{"type", m_options.type},
+                {"hausdorff", h.symmetric},
+                {"linf", h.a_to_b.linf},
+                {"l1", h.a_to_b.l1},
+                {"vertex_linf", h.a_to_b.vertex_linf},
+                {"vertex_l1", h.a_to_b.vertex_l1},
+                {"exact_to_surface_linf", h.b_to_a.linf},
+                {"exact_to_surface_l1", h.b_to_a.l1}};
+    }
 
     tracker::SurfaceError error(const SurfaceMesh& mesh, double t) const {
         if (m_options.type == "two_sphere_normal_flow")
@@ -178,6 +225,8 @@ private:
 
     ExactSolutionOptions m_options;
     tracker::TwoSphereNormalFlow m_two_spheres;
+    tracker::RigidMotionField m_rigid;
+    SurfaceMesh m_initial;  ///< rigid_motion: the surface at t = 0
     std::string m_source;
 };
 
@@ -599,7 +648,7 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
     // --frames keeps the time per frame of the scene.
     const double frame_dt = scene.time.end / scene.time.frames;
     const double end_time = frame_dt * frames;
-    const ExactSolution exact(scene, end_time);
+    ExactSolution exact(scene, end_time);
     if (exact.enabled())
         exact.check_end(end_time);
 
@@ -660,7 +709,7 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
             start = Clock::now();
             dt = offered;
             if (flow.stepper) {
-                const tracker::FlowStep step = flow.stepper->step(mesh, t, offered);
+                const tracker::FlowStep step = flow_step(*flow.stepper, mesh, t, offered, scene);
                 dt = step.dt;
                 work.flow_shortenings += step.shortened ? 1 : 0;
                 for (size_t vi = 0; vi < step.displacements.size(); ++vi)

@@ -16,7 +16,8 @@ using tracker::ShapePtr;
 using Vec3 = Eigen::Vector3d;
 
 const std::vector<std::string> FLOW_TYPES = {"fluid",          "enright",    "normal_speed",
-                                             "mean_curvature", "curl_noise", "none"};
+                                             "mean_curvature", "curl_noise", "rigid",
+                                             "expression",     "none"};
 const std::vector<std::string> NORMAL_SPEED_METHODS = {"face_offsetting", "vertex_normals"};
 const std::vector<std::pair<std::string, tracker::MeanCurvatureIntegrator>>
     MEAN_CURVATURE_INTEGRATORS = {{"forward_euler", tracker::MeanCurvatureIntegrator::forward_euler},
@@ -25,7 +26,7 @@ const std::vector<std::pair<std::string, tracker::CurvatureOperator>> CURVATURE_
     {"cotangent", tracker::CurvatureOperator::cotangent},
     {"quartic_fit", tracker::CurvatureOperator::quartic_fit}};
 const std::vector<std::string> EXACT_TYPES = {"none", "two_sphere_normal_flow",
-                                              "sphere_mean_curvature"};
+                                              "sphere_mean_curvature", "rigid_motion"};
 
 /// Reads/describes an enum through its names (the first name is used for the reference).
 template <typename V, typename Enum>
@@ -161,6 +162,9 @@ void visit_fields(V& v, SurfaceOptions& o) {
                  "an edge whose end normals turn by more than this crosses a crease");
         r.number("band", o.crease.band, Range::non_negative(), "m",
                  "refine within this distance of a crease (0 = twice edge_length)");
+        r.boolean("snap", o.crease.snap,
+                  "before refining, move vertices onto the creases and flip edges to run along "
+                  "them (sharp edges become mesh edges instead of chamfers; needs angle < π/2)");
     });
     v.boolean("open", o.open,
               "the mesh_file is an open surface with boundary edges (paper §4.4; geometric flows "
@@ -232,7 +236,9 @@ void visit_fields(V& v, ExactSolutionOptions& o) {
     v.choice("type", o.type, EXACT_TYPES,
              "`two_sphere_normal_flow` (A1: needs /flow/type normal_speed with speed > 0) or "
              "`sphere_mean_curvature` (needs /flow/type mean_curvature); the initial surface must "
-             "be that shape (checked when the run starts)");
+             "be that shape (checked when the run starts); or `rigid_motion` (needs /flow/type "
+             "rigid; any surface: the initial one carried by the exact rigid map, compared both "
+             "ways, with the symmetric Hausdorff distance in `hausdorff`)");
     v.vec3("center0", o.center0, Range::any(), "m", "first sphere's centre (the sphere's centre)");
     v.vec3("center1", o.center1, Range::any(), "m", "second sphere's centre (two spheres only)");
     v.number("radius", o.radius, Range::positive(), "m", "initial radius of the sphere(s)");
@@ -245,7 +251,8 @@ void visit_fields(V& v, FlowOptions& o) {
     v.choice("type", o.type, FLOW_TYPES,
              "what moves the surface: `fluid` (coupled Navier–Stokes), `enright` (paper §4.3 "
              "deformation test, RK4), `normal_speed` (§4.1), `mean_curvature` (§4.2, CFL-limited "
-             "forward Euler or Heun), `curl_noise` (§4.3, RK4), `none`");
+             "forward Euler or Heun), `curl_noise` (§4.3, RK4), `rigid` (rotation and "
+             "translation, RK4), `expression` (a user's analytic field, RK4), `none`");
     v.number("period", o.period, Range::positive(), "s",
              "Enright period T; the field is modulated by sin(2πt/T)");
     v.section("normal_speed", "motion in the normal direction (type normal_speed)",
@@ -270,6 +277,26 @@ void visit_fields(V& v, FlowOptions& o) {
     });
     v.section("curl_noise", "divergence-free pseudorandom field (type curl_noise)",
               [&](auto& r) { visit_fields(r, o.curl_noise); });
+    v.section("rigid", "rigid rotation and translation (type rigid), advected by RK4",
+              [&](auto& r) {
+                  r.vec3("angular_velocity", o.rigid.angular_velocity, Range::any(), "rad/s",
+                         "ω: rotation axis times rate, right-handed; u = v + ω × (x − c(t))");
+                  r.vec3("center", o.rigid.center, Range::any(), "m",
+                         "c₀: centre of rotation at t = 0");
+                  r.vec3("velocity", o.rigid.velocity, Range::any(), "m/s",
+                         "v: translation; the centre moves with it, c(t) = c₀ + v t");
+              });
+    v.section("expression",
+              "a user's analytic velocity field (type expression), advected by RK4", [&](auto& r) {
+                  r.text3("velocity", o.expression.velocity,
+                          "u, v, w as expressions in x, y, z (m), t (s), `pi` and `constants`: "
+                          "numbers, + - * / ^ (right-associative; -x^2 = -(x^2)), parentheses, "
+                          "sin cos tan asin acos atan sinh cosh tanh exp log log10 sqrt abs floor "
+                          "ceil sign, atan2(y, x) pow(a, b) mod(a, b), min(a, b, …) max(a, b, …); "
+                          "e.g. `[\"-2*pi*(y-0.5)\", \"2*pi*(x-0.5)\", 0]`");
+                  r.number_map("constants", o.expression.constants, "",
+                               "named numbers the expressions may use, e.g. `{\"omega\": 6.28}`");
+              });
     v.section("exact", "exact solution whose error is recorded in stats.jsonl every frame",
               [&](auto& r) { visit_fields(r, o.exact); });
 }
@@ -494,7 +521,8 @@ void validate_at(const Options& options, const std::string& path) {
 void validate_flow(const Scene& scene, const nlohmann::json& j) {
     const FlowOptions& f = scene.flow;
     const nlohmann::json* flow = j.contains("flow") ? &j.at("flow") : nullptr;
-    for (const char* section : {"normal_speed", "mean_curvature", "curl_noise"})
+    for (const char* section :
+         {"normal_speed", "mean_curvature", "curl_noise", "rigid", "expression"})
         if (flow && flow->contains(section) && f.type != section)
             throw SceneError(std::string("/flow/") + section + ": given, but /flow/type is \"" +
                              f.type + "\"");
@@ -502,6 +530,8 @@ void validate_flow(const Scene& scene, const nlohmann::json& j) {
     validate_at(f.normal_speed.inversion, "/flow/normal_speed/");
     validate_at(f.mean_curvature, "/flow/mean_curvature/");
     validate_at(f.curl_noise, "/flow/curl_noise/");
+    validate_at(f.rigid, "/flow/rigid/");
+    validate_at(f.expression, "/flow/expression/");
     validate_at(f.exact.sampling, "/flow/exact/");
     const ExactSolutionOptions& e = f.exact;
     if (e.type == "none") {
@@ -510,6 +540,16 @@ void validate_flow(const Scene& scene, const nlohmann::json& j) {
                 if (item.key() != "type")
                     throw SceneError("/flow/exact/" + item.key() +
                                      ": given, but /flow/exact/type is \"none\"");
+        return;
+    }
+    if (e.type == "rigid_motion") {
+        if (f.type != "rigid")
+            throw SceneError("/flow/exact/type: rigid_motion solves /flow/type rigid");
+        for (const char* key : {"center0", "center1", "radius"})
+            if (flow->at("exact").contains(key))
+                throw SceneError(std::string("/flow/exact/") + key +
+                                 ": not used by /flow/exact/type rigid_motion (the exact surface "
+                                 "is the initial one, moved)");
         return;
     }
     if (e.type == "two_sphere_normal_flow") {
@@ -587,7 +627,7 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
             throw SceneError("/time/land_on_frames: fluid scenes always land on frame times");
         if (scene.surface.open && scene.shape)
             throw SceneError("/surface/open: only a mesh_file can be open (shapes are closed)");
-        if (scene.surface.crease.levels > 0 && !scene.shape)
+        if ((scene.surface.crease.levels > 0 || scene.surface.crease.snap) && !scene.shape)
             throw SceneError(
                 "/surface/crease/levels: crease refinement needs a `shape` (it "
                 "moves new vertices onto the exact surface)");

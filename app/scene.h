@@ -8,6 +8,7 @@
 #include "tracker/flows/face_offsetting.h"
 #include "tracker/flows/flow_errors.h"
 #include "tracker/flows/mean_curvature.h"
+#include "tracker/flows/velocity_field.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/implicit_shape.h"
 #include "tracker/surface_tracker.h"
@@ -49,8 +50,9 @@ struct NormalSpeedOptions {
 struct ExactSolutionOptions {
     /// "none", "two_sphere_normal_flow" (A1: two balls of `radius` around `center0`/`center1`
     /// under /flow/normal_speed with speed > 0; the exact entropy solution of
-    /// tracker::TwoSphereNormalFlow) or "sphere_mean_curvature" (a ball of `radius` around
-    /// `center0` under mean-curvature flow: R(t) = sqrt(R₀² − 4t)).
+    /// tracker::TwoSphereNormalFlow), "sphere_mean_curvature" (a ball of `radius` around
+    /// `center0` under mean-curvature flow: R(t) = sqrt(R₀² − 4t)) or "rigid_motion" (under
+    /// /flow/type rigid, the initial surface carried by the exact rigid map; any shape).
     std::string type = "none";
     Eigen::Vector3d center0 = Eigen::Vector3d(-0.25, 0.0, 0.0);  ///< m
     Eigen::Vector3d center1 = Eigen::Vector3d(0.25, 0.0, 0.0);   ///< m (two spheres only)
@@ -63,13 +65,16 @@ struct ExactSolutionOptions {
 /// (§4).
 struct FlowOptions {
     /// "fluid" (the coupled Navier–Stokes solver moves the surface), "enright" (paper §4.3),
-    /// "normal_speed" (§4.1), "mean_curvature" (§4.2), "curl_noise" (§4.3) or "none" (the
-    /// surface stays still).
+    /// "normal_speed" (§4.1), "mean_curvature" (§4.2), "curl_noise" (§4.3), "rigid" (rotation
+    /// and translation), "expression" (a user's analytic field) or "none" (the surface stays
+    /// still).
     std::string type = "enright";
     double period = 3.0;  ///< Enright period T: velocity modulated by sin(2πt/T) (s)
     NormalSpeedOptions normal_speed;
     tracker::MeanCurvatureFlowOptions mean_curvature;
     tracker::CurlNoiseOptions curl_noise;
+    tracker::RigidMotionOptions rigid;
+    tracker::ExpressionFieldOptions expression;
     ExactSolutionOptions exact;
 };
 

@@ -8,6 +8,7 @@
 #include "app/validate_parameters.h"
 #include "app/validate_report.h"
 #include "app/validate_run.h"
+#include "app/validate_zalesak.h"
 #include "coupling/levelset_reference.h"
 #include "tracker/flows/axisymmetric_mcf_reference.h"
 #include "tracker/flows/curl_noise.h"
@@ -87,6 +88,8 @@ std::vector<double> case_xis(const std::string& id, bool full) {
         xis = {CURL_XI};
         if (full)
             xis.insert(xis.end(), std::begin(CURL_XI_FULL), std::end(CURL_XI_FULL));
+    } else if (id == "A6") {
+        xis = zalesak_xis(full);
     }
     return xis;
 }
@@ -556,6 +559,12 @@ void case_a4(Context& c) {
     }
 }
 
+void case_a6(Context& c) {
+    run_zalesak(
+        c.full, c.quiet, [&c](double xi) { return c.runs_xi(xi); },
+        [&c](Json run, const RunResult& r) { c.add(std::move(run), r); });
+}
+
 /// Whether `options` selects case `id` (no --case selects every case).
 bool case_selected(const ValidateOptions& options, const char* id) {
     return options.cases.empty() ||
@@ -566,16 +575,17 @@ bool case_selected(const ValidateOptions& options, const char* id) {
 
 void check_validate_options(const ValidateOptions& options) {
     for (const std::string& id : options.cases)
-        if (!is_fluid_case(id) && id != "A1" && id != "A2" && id != "A3" && id != "A4")
+        if (!is_fluid_case(id) && id != "A1" && id != "A2" && id != "A3" && id != "A4" &&
+            id != "A6")
             throw std::invalid_argument("validate: unknown case '" + id +
-                                        "' (expected A1, A2, A3, A4 or B1 … B7)");
+                                        "' (expected A1, A2, A3, A4, A6 or B1 … B7)");
     for (const std::string& name : options.curvature_operators)
         if (name != "cotangent" && name != "quartic_fit")
             throw std::invalid_argument("validate: unknown curvature operator '" + name +
                                         "' (expected cotangent or quartic_fit)");
     for (double xi : options.xis) {  // each requested ξ must be one a selected case runs
         std::vector<double> offered;
-        for (const char* id : {"A1", "A2", "A3", "A4"})
+        for (const char* id : {"A1", "A2", "A3", "A4", "A6"})
             if (case_selected(options, id))
                 for (double x : case_xis(id, options.full))
                     if (std::find(offered.begin(), offered.end(), x) == offered.end())
@@ -620,6 +630,8 @@ int run_validation(const ValidateOptions& options) {
         case_a3(c);
     if (case_selected(options, "A4"))
         case_a4(c);
+    if (case_selected(options, "A6"))
+        case_a6(c);
     FluidValidation part_b;
     if (any_fluid_case) {
         part_b = run_fluid_validation({options.full, options.quiet, fluid_cases, out});

@@ -1,7 +1,7 @@
 #pragma once
 /// \file `meniscus validate`: runs the paper's geometric-flow validation cases
 /// (/work/shared/VALIDATION.md part A: A1 normal flow, A2 mean curvature, A3 Enright, A4 curl
-/// noise, A5 per-phase cost) through the collision-safe SurfaceTracker and writes, into one
+/// noise, A5 per-phase cost; and A6, Zalesak's notched sphere turned once, app/validate_zalesak.h) through the collision-safe SurfaceTracker and writes, into one
 /// folder, `report.md` (our numbers beside the paper's, observed orders, per-phase seconds per
 /// step), `results.json` (every number and time series) and PNG plots made by
 /// `plot_validation.py` (written beside them; needs /usr/bin/python3 with matplotlib).
@@ -18,7 +18,7 @@ struct ValidateOptions {
     bool full = false;
     std::string out_dir = "validation";  ///< folder for report.md, results.json and plots
     bool quiet = false;                  ///< no progress lines on stderr
-    /// Cases to run ("A1", "A2", "A3", "A4"; A5 is timed on the A1 runs; "B1" … "B5": part B,
+    /// Cases to run ("A1", "A2", "A3", "A4", "A6"; A5 is timed on the A1 runs; "B1" … "B5": part B,
     /// two-phase flow, app/validate_fluid.h); empty: all.
     std::vector<std::string> cases;
     /// Resolutions ξ (m) of part A to run, each one of the selected cases' own (e.g. 0.01 with

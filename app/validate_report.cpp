@@ -5,6 +5,7 @@
 
 #include "app/plot_script.h"
 #include "app/validate_parameters.h"
+#include "app/validate_zalesak.h"
 #include "tracker/flows/curl_noise.h"
 #include "tracker/flows/mean_curvature.h"
 #include "tracker/remesh_options.h"
@@ -664,7 +665,29 @@ def exact_sphere(ax, r):
     ax.plot(ts, [4.0 / 3.0 * math.pi * (r0 * r0 - 4.0 * t) ** 1.5 for t in ts], "k:",
             label="exact sphere R(t) = sqrt(R0^2 - 4t), xi=%g" % r["xi_requested"])
 
-for case in ("A1", "A2", "A3", "A4"):
+rs = sel("A6")
+if rs:
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    xs = [r["xi"] for r in rs]
+    ax.loglog(xs, [r["hausdorff"]["symmetric"] for r in rs], "o-", label="Hausdorff (symmetric)")
+    ax.loglog(xs, [r["hausdorff"]["final_to_initial"]["l1"] for r in rs], "s--",
+              label="mean distance final -> initial")
+    ax.loglog(xs, [r["hausdorff"]["initial_to_final"]["l1"] for r in rs], "d:",
+              label="mean distance initial -> final")
+    for order, style in ((1, "k-"), (2, "k--")):
+        h0 = rs[0]["hausdorff"]["symmetric"]
+        ax.loglog(xs, [h0 * (x / xs[0]) ** order for x in xs], style, alpha=0.3,
+                  label="order %d" % order)
+    ax.set_xlabel("xi (initial mean edge length)")
+    ax.set_ylabel("distance to the initial surface after one turn (m)")
+    ax.set_title("A6 Zalesak's notched sphere, one rigid turn")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "a6_hausdorff.png"), dpi=120)
+    plt.close(fig)
+
+for case in ("A1", "A2", "A3", "A4", "A6"):
     c = case.lower()
     if case in ("A1", "A2"):  # growing and shrinking flows: the volume itself
         series_plot(case, "volume", c + "_volume.png", "volume (m^3)",
@@ -680,7 +703,7 @@ std::string make_plots(const std::filesystem::path& out) {
         return "**Plots failed** (`" + std::string(PLOT_PYTHON) +
                "` with matplotlib is needed; see plot_errors.txt): the report has no PNGs.";
     return "Plots (PNG, made by `plot_validation.py` from results.json): a1_error.png, "
-           "aN_volume.png, aN_triangles.png for each case run.";
+           "a6_hausdorff.png, aN_volume.png, aN_triangles.png for each case run.";
 }
 
 }  // namespace
@@ -692,6 +715,7 @@ std::string geometric_flow_report(Json& results) {
     report_a2(md, results);
     report_a3(md, results);
     report_a4(md, results);
+    md << flow_validation::zalesak_report(results);
     return md.str();
 }
 

@@ -9,7 +9,7 @@
 
 namespace meniscus::app {
 
-/// The Markdown sections A1, A5, A2, A3 and A4 from results["runs"] (as validate.cpp writes
+/// The Markdown sections A1, A5, A2, A3, A4 and A6 from results["runs"] (as validate.cpp writes
 /// them), each run beside the paper's numbers; adds the observed orders of convergence to
 /// results["orders"].
 std::string geometric_flow_report(nlohmann::json& results);

@@ -58,6 +58,7 @@ RunResult run_tracked(const RunSpec& spec, bool quiet) {
     tracker::SurfaceTracker tr(std::move(initial), tracker_options);
     const SurfaceMesh& mesh = tr.mesh();
     r.xi = tr.characteristic_length();
+    r.initial_mesh = mesh;
     r.initial_volume = tracker::enclosed_volume(mesh);
     r.initial_intersecting_pairs =
         static_cast<int>(tracker::find_self_intersections(mesh).triangle_pairs.size());

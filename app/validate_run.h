@@ -63,6 +63,7 @@ struct RunResult {
     int initial_intersecting_pairs = 0;
     std::vector<double> series_t, series_volume;
     std::vector<int> series_triangles, series_pairs, series_components;
+    tracker::SurfaceMesh initial_mesh;  ///< as the tracker started (after meshing the shape)
     tracker::SurfaceMesh final_mesh;
     double wall_seconds = 0.0;
 };

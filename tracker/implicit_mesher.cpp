@@ -1,6 +1,7 @@
 #include "tracker/implicit_mesher.h"
 
 #include "tracker/broadphase.h"
+#include "tracker/crease_snap.h"
 #include "tracker/isotropic_remesh.h"
 #include "tracker/mesh_measures.h"
 
@@ -266,6 +267,8 @@ void CreaseRefinementOptions::validate() const {
                                     std::to_string(MAX_LEVELS) + "]");
     if (!(angle > 0.0 && angle < M_PI))
         throw std::invalid_argument("crease.angle: expected radians in (0, pi)");
+    if (snap && !(angle < 0.5 * M_PI))
+        throw std::invalid_argument("crease.angle: expected radians in (0, pi/2) with snap");
     if (!(band >= 0.0) || !std::isfinite(band))
         throw std::invalid_argument("crease.band: expected a number >= 0");
 }
@@ -301,6 +304,13 @@ SurfaceMesh mesh_implicit_shape(const ImplicitShape& shape, const ImplicitMeshOp
     isotropic_remesh(mesh, remesh, [&shape, newton](const Vec3& p) {
         return project_to_zero_set(shape, p, newton);
     });
+    CreaseSnapReport snapped;
+    if (options.crease.snap) {
+        CreaseSnapOptions snap;
+        snap.angle = options.crease.angle;
+        snap.projection_iterations = options.projection_iterations;
+        snapped = snap_to_creases(mesh, shape, snap);
+    }
     const double unrefined_mean_edge_length = edge_length_stats(mesh).mean;
     int crease_vertices = 0;
     const int crease_splits = refine_creases(mesh, shape, options, &crease_vertices);
@@ -308,6 +318,9 @@ SurfaceMesh mesh_implicit_shape(const ImplicitShape& shape, const ImplicitMeshOp
         report->unrefined_mean_edge_length = unrefined_mean_edge_length;
         report->crease_vertices = crease_vertices;
         report->crease_splits = crease_splits;
+        report->crease_snaps = snapped.snaps;
+        report->crease_flips = snapped.flips;
+        report->snapped_vertices = snapped.crease_vertices;
         report->vertices = mesh.count_live_vertices();
         report->triangles = mesh.count_live_triangles();
         report->mean_edge_length = edge_length_stats(mesh).mean;

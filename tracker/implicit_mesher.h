@@ -21,11 +21,17 @@ namespace meniscus::tracker {
 /// its pinch is 2–3× smaller (app/validate_parameters.h). Give a tracker of the refined mesh the
 /// unrefined ξ (ImplicitMeshReport::nominal_characteristic_length(),
 /// TrackerOptions::characteristic_length), or every size it derives from ξ shrinks too.
+///
+/// `snap` (before any refinement): vertices near a crease move onto it and edges cutting across
+/// it flip to run along it (tracker/crease_snap.h, with `angle`), so that sharp edges such as a
+/// slot cut into a ball are edges of the mesh instead of chamfers whose triangles leave the
+/// surface by up to half their size. Edge lengths stay those of the remeshing.
 struct CreaseRefinementOptions {
     static constexpr int MAX_LEVELS = 4;  ///< 16× finer than edge_length at most
     int levels = 0;                       ///< halvings, in [0, MAX_LEVELS]; 0 = off
-    double angle = 0.35;                  ///< radians, in (0, π)
+    double angle = 0.35;                  ///< radians, in (0, π); with snap in (0, π/2)
     double band = 0.0;                    ///< metres, ≥ 0; 0 = 2·edge_length
+    bool snap = false;                    ///< put vertices and edges onto the creases
     void validate() const;                ///< throws std::invalid_argument naming the field
 };
 
@@ -51,6 +57,9 @@ struct ImplicitMeshReport {
     double unrefined_mean_edge_length = 0.0;
     int crease_vertices = 0;  ///< crease vertices found before crease refinement
     int crease_splits = 0;    ///< edges split by crease refinement
+    int crease_snaps = 0;     ///< vertex moves onto creases (CreaseRefinementOptions::snap)
+    int crease_flips = 0;     ///< edges flipped to run along creases
+    int snapped_vertices = 0; ///< vertices on a crease or corner after snapping
 
     /// The ξ to give a tracker of this mesh (TrackerOptions::characteristic_length): the
     /// unrefined mean edge length when crease refinement split edges, else 0 (the tracker then

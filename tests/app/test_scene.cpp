@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -127,7 +128,8 @@ TEST(Scene, ErrorsNameTheJsonPath) {
               std::string::npos);
     EXPECT_NE(error_of(R"({"flow": {"type": "wind"}, "surface": {"shape": {"type": "sphere"}}})")
                   .find("/flow/type: expected one of \"fluid\", \"enright\", \"normal_speed\", "
-                        "\"mean_curvature\", \"curl_noise\", \"none\", got \"wind\""),
+                        "\"mean_curvature\", \"curl_noise\", \"rigid\", \"expression\", "
+                        "\"none\", got \"wind\""),
               std::string::npos);
     EXPECT_NE(error_of("[1, 2]").find("/: expected an object"), std::string::npos);
 }
@@ -224,6 +226,95 @@ TEST(Scene, GeometricFlowErrorsNameTheJsonPath) {
     EXPECT_NE(error_with(R"("flow": {"type": "normal_speed", "normal_speed": {"reversal_time": 1}, "exact": {"type": "two_sphere_normal_flow"}}, "time": {"end": 5})")
                   .find("/time/end: past the time the exact two-sphere surface vanishes"),
               std::string::npos);
+}
+
+TEST(Scene, PrescribedVelocityFieldKeys) {
+    const Scene r = parse_scene(R"J({"surface": {"shape": {"type": "sphere"}},
+        "flow": {"type": "rigid", "rigid": {"angular_velocity": [0, 0, 6.283185307179586],
+                 "center": [0.5, 0.5, 0.5], "velocity": [0.1, 0, 0]}}})J",
+                                "t.json", ".");
+    EXPECT_EQ(r.flow.type, "rigid");
+    EXPECT_EQ(r.flow.rigid.angular_velocity, Eigen::Vector3d(0, 0, 6.283185307179586));
+    EXPECT_EQ(r.flow.rigid.center, Eigen::Vector3d(0.5, 0.5, 0.5));
+    EXPECT_EQ(r.flow.rigid.velocity, Eigen::Vector3d(0.1, 0, 0));
+    const Scene e = parse_scene(R"J({"surface": {"shape": {"type": "sphere"}},
+        "flow": {"type": "expression", "expression": {
+                 "velocity": ["-omega*(y - 0.5)", "omega*(x - 0.5)", 0.25],
+                 "constants": {"omega": 6.28}}}})J",
+                                "t.json", ".");
+    EXPECT_EQ(e.flow.expression.velocity[0], "-omega*(y - 0.5)");
+    EXPECT_EQ(e.flow.expression.velocity[2], "0.25");  // a number stands for its text
+    EXPECT_EQ(e.flow.expression.constants.at("omega"), 6.28);
+    const tracker::ExpressionField field(e.flow.expression);
+    EXPECT_LT((field.velocity({1.0, 0.5, 0.0}, 0.0) - tracker::Vec3(0, 6.28 * 0.5, 0.25)).norm(),
+              1e-15);
+    // Defaults: no motion.
+    const Scene d = parse_scene(
+        R"J({"surface": {"shape": {"type": "sphere"}}, "flow": {"type": "expression"}})J", "t.json",
+        ".");
+    EXPECT_EQ(d.flow.expression.velocity[1], "0");
+    EXPECT_EQ(d.flow.rigid.angular_velocity, Eigen::Vector3d::Zero());
+}
+
+TEST(Scene, PrescribedVelocityFieldErrorsNameTheJsonPathAndColumn) {
+    const std::string sphere = R"J("surface": {"shape": {"type": "sphere"}})J";
+    const auto error_with = [&](const std::string& rest) {
+        return error_of("{" + sphere + ", " + rest + "}");
+    };
+    const auto expect_error = [&](const std::string& rest, const std::string& says) {
+        const std::string what = error_with(rest);
+        EXPECT_NE(what.find(says), std::string::npos) << "got: " << what;
+    };
+    expect_error(R"J("flow": {"type": "rigid", "rigid": {"omega": [0, 0, 1]}})J",
+                 "/flow/rigid/omega: unknown key (known keys here: angular_velocity, center, "
+                 "velocity)");
+    expect_error(R"J("flow": {"type": "rigid", "rigid": {"center": [0, 0]}})J",
+                 "/flow/rigid/center: expected an array of 3 numbers");
+    expect_error(R"J("flow": {"type": "enright", "rigid": {"center": [0, 0, 0]}})J",
+                 "/flow/rigid: given, but /flow/type is \"enright\"");
+    expect_error(R"J("flow": {"type": "rigid", "expression": {"velocity": ["0", "0", "0"]}})J",
+                 "/flow/expression: given, but /flow/type is \"rigid\"");
+    expect_error(R"J("flow": {"type": "expression", "expression": {"speed": 1}})J",
+                 "/flow/expression/speed: unknown key (known keys here: constants, velocity)");
+    expect_error(R"J("flow": {"type": "expression", "expression": {"velocity": ["x", "y"]}})J",
+                 "/flow/expression/velocity: expected an array of 3 strings (or numbers), got an "
+                 "array of 2");
+    expect_error(R"J("flow": {"type": "expression", "expression": {"velocity": ["x", true, "0"]}})J",
+                 "/flow/expression/velocity/1: expected a string or a number, got a boolean");
+    expect_error(R"J("flow": {"type": "expression", "expression": {"velocity": ["x", "sin(y", "0"]}})J",
+                 "/flow/expression/velocity/1: column 6: missing ')' for the call of sin at "
+                 "column 1");
+    expect_error(R"J("flow": {"type": "expression", "expression": {"velocity": ["0", "0", "2*k"]}})J",
+                 "/flow/expression/velocity/2: column 3: unknown name 'k'");
+    expect_error(R"J("flow": {"type": "expression", "expression": {"constants": {"k": "1"}}})J",
+                 "/flow/expression/constants/k: expected a number, got a string");
+    expect_error(R"J("flow": {"type": "expression", "expression": {"constants": {"t": 1}}})J",
+                 "/flow/expression/constants/t: ");
+    expect_error(R"J("flow": {"type": "expression", "expression": {"constants": {"sin": 1}}})J",
+                 "/flow/expression/constants/sin: a built-in name");
+    expect_error(R"J("flow": {"type": "spin"})J", "/flow/type: expected one of");
+}
+
+TEST(Scene, ExpressionFieldThatIsNotFiniteOnTheSurfaceStopsTheRunNamingIt) {
+    Scene scene = parse_scene(R"J({"surface": {"shape": {"type": "sphere", "radius": 0.2},
+        "edge_length": 0.1}, "flow": {"type": "expression",
+        "expression": {"velocity": ["0", "sqrt(x)", "0"]}}, "output": {"vdb": false}})J",
+                              "field.json", ".");
+    RunOptions options;
+    options.out_dir = (std::filesystem::temp_directory_path() / "meniscus_nan_field").string();
+    options.quiet = true;
+    options.max_steps = 2;
+    const std::atomic<bool> stop{false};
+    try {
+        run_scene(scene, options, stop);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("field.json: /flow/expression/velocity/1 (\"sqrt(x)\") is"),
+                  std::string::npos)
+            << what;
+    }
+    std::filesystem::remove_all(options.out_dir);
 }
 
 TEST(Scene, OnlyMeshFilesOfGeometricFlowsMayBeOpen) {

@@ -12,6 +12,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -274,6 +275,37 @@ TEST_F(QuickValidation, EnrightQuickConservesVolumeAndReturns) {
     EXPECT_LT(s[0]["error_to_initial_sphere"]["linf"].get<double>(), ENRIGHT_QUICK_RETURN_LINF);
 }
 
+/// A6 quick (ξ = 0.04, 0.02, snapped onto the slot's edges), measured: volume change
+/// +0.0133 %, +0.0011 %; Hausdorff distance to the start after one turn 0.051 ξ, 0.026 ξ; mean
+/// distance 1.3e-4, 2.6e-5. At ξ = 0.04 the slot is 1.25 edges wide.
+constexpr double ZALESAK_QUICK_VOLUME_PERCENT = 0.03;
+constexpr double ZALESAK_QUICK_HAUSDORFF_XI = 0.1;
+
+TEST_F(QuickValidation, ZalesakNotchedSphereComesBackAfterOneTurn) {
+    const std::vector<Json> s = runs("A6", "notched sphere");
+    ASSERT_EQ(s.size(), 2u);
+    for (const Json& r : s) {
+        SCOPED_TRACE("ξ = " + r["xi_requested"].dump());
+        EXPECT_TRUE(r["completed"].get<bool>());
+        EXPECT_EQ(r["max_intersecting_pairs"].get<int>(), 0);
+        EXPECT_DOUBLE_EQ(r["t_reached"].get<double>(), 1.0);  // one whole turn
+        EXPECT_LT(std::abs(r["volume_change_percent"].get<double>()), ZALESAK_QUICK_VOLUME_PERCENT);
+        EXPECT_LT(r["hausdorff"]["symmetric_over_xi"].get<double>(), ZALESAK_QUICK_HAUSDORFF_XI);
+        EXPECT_EQ(r["hausdorff"]["symmetric"].get<double>(),
+                  std::max(r["hausdorff"]["final_to_initial"]["linf"].get<double>(),
+                           r["hausdorff"]["initial_to_final"]["linf"].get<double>()));
+    }
+    // Finer is closer: the mean distance and the volume change shrink with ξ.
+    EXPECT_LT(s[1]["hausdorff"]["final_to_initial"]["l1"].get<double>(),
+              0.5 * s[0]["hausdorff"]["final_to_initial"]["l1"].get<double>());
+    EXPECT_LT(std::abs(s[1]["volume_change_percent"].get<double>()),
+              0.5 * std::abs(s[0]["volume_change_percent"].get<double>()));
+    ASSERT_EQ(s_results["orders"]["A6 notched sphere"].size(), 1u);
+    EXPECT_NE(s_report.find("## A6 — Zalesak's notched sphere"), std::string::npos);
+    EXPECT_NE(s_report.find("| ξ | measured ξ | steps | Δt | triangles | volume change %"),
+              std::string::npos);
+}
+
 TEST_F(QuickValidation, VolumeChangeByPhaseSumsToTheVolumeChange) {
     for (const Json& r : s_results["runs"]) {
         SCOPED_TRACE(r["case"].get<std::string>() + " " + r["label"].get<std::string>());
@@ -289,7 +321,7 @@ TEST_F(QuickValidation, VolumeChangeByPhaseSumsToTheVolumeChange) {
 
 TEST_F(QuickValidation, ReportHasEveryCaseTable) {
     ASSERT_TRUE(fs::exists(s_out / "report.md"));
-    for (const char* heading : {"## A1", "## A2", "## A3", "## A4", "## A5"})
+    for (const char* heading : {"## A1", "## A2", "## A3", "## A4", "## A5", "## A6"})
         EXPECT_NE(s_report.find(heading), std::string::npos) << heading;
     for (const char* table :
          {"| ξ | measured ξ | t | steps | triangles | L∞ | L∞ paper",
@@ -420,9 +452,16 @@ TEST(ValidateOptionsCheck, NamesTheXiNoSelectedCaseRunsAndTheOnesTheyDo) {
     EXPECT_THROW(check_validate_options(options), std::invalid_argument);
     options.cases = {"A3", "A4"};
     EXPECT_NO_THROW(check_validate_options(options));
-    options.cases = {"A6"};
+    options.cases = {"A7"};
     options.xis.clear();
     EXPECT_THROW(check_validate_options(options), std::invalid_argument);
+    // A6 runs ξ = 0.04 and 0.02 in quick mode, 0.02, 0.01 and 0.005 in full mode.
+    options.cases = {"A6"};
+    options.full = false;
+    options.xis = {0.005};
+    EXPECT_THROW(check_validate_options(options), std::invalid_argument);
+    options.full = true;
+    EXPECT_NO_THROW(check_validate_options(options));
 }
 
 TEST(ValidateOptionsCheck, NamesAnUnknownCurvatureOperator) {

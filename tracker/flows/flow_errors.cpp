@@ -1,5 +1,6 @@
 #include "tracker/flows/flow_errors.h"
 
+#include "tracker/mesh_distance.h"
 #include "tracker/mesh_measures.h"
 
 #include <algorithm>
@@ -175,6 +176,17 @@ SurfaceError sphere_error(const SurfaceMesh& mesh, const Vec3& center, double ra
         throw std::invalid_argument("radius: expected a finite number > 0 (metres)");
     return surface_error(
         mesh, [&center, radius](const Vec3& x) { return (x - center).norm() - radius; }, options);
+}
+
+HausdorffDistance hausdorff_distance(const SurfaceMesh& a, const SurfaceMesh& b,
+                                     const SurfaceErrorOptions& options) {
+    options.validate();
+    const MeshDistance to_a(a), to_b(b);
+    HausdorffDistance h;
+    h.a_to_b = surface_error(a, [&to_b](const Vec3& x) { return to_b.distance(x); }, options);
+    h.b_to_a = surface_error(b, [&to_a](const Vec3& x) { return to_a.distance(x); }, options);
+    h.symmetric = std::max(h.a_to_b.linf, h.b_to_a.linf);
+    return h;
 }
 
 double relative_volume_change(double initial_volume, double volume) {

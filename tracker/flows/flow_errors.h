@@ -99,6 +99,24 @@ double sphere_mean_curvature_radius(double initial_radius, double t);
 SurfaceError sphere_error(const SurfaceMesh& mesh, const Vec3& center, double radius,
                           const SurfaceErrorOptions& options = {});
 
+/// Sampled Hausdorff distance between two meshes (metres). Each one-sided part samples one
+/// mesh as surface_error() does (vertices, lattice points and sub-triangle centroids) and
+/// measures the unsigned distance of every sample to the nearest live triangle of the other
+/// mesh (MeshDistance, exact point–triangle distances): its `linf` is the one-sided Hausdorff
+/// distance over the samples (a lower bound on the continuous one, closer to it than the
+/// sample spacing, edge / triangle_subdivisions), its `l1` the area-weighted mean distance.
+/// The signed vertex fields of SurfaceError are unsigned here.
+struct HausdorffDistance {
+    SurfaceError a_to_b;     ///< distances of samples of `a` from `b`
+    SurfaceError b_to_a;     ///< distances of samples of `b` from `a`
+    double symmetric = 0.0;  ///< max(a_to_b.linf, b_to_a.linf)
+};
+
+/// Hausdorff distance between the live triangles of `a` and `b` (see HausdorffDistance).
+/// Throws std::invalid_argument if either has no live triangle or on invalid options.
+HausdorffDistance hausdorff_distance(const SurfaceMesh& a, const SurfaceMesh& b,
+                                     const SurfaceErrorOptions& options = {});
+
 /// Relative volume change (V − V₀) / V₀ (dimensionless; ×100 for the paper's percentages).
 /// Throws std::invalid_argument if V₀ is zero or not finite.
 double relative_volume_change(double initial_volume, double volume);
