@@ -110,16 +110,18 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
                              {{"coupled", fluid::ViscousPressureCoupling::coupled},
                               {"incremental", fluid::ViscousPressureCoupling::incremental},
                               {"split", fluid::ViscousPressureCoupling::split}},
-                             "`coupled`: rotational pressure increment repeated to the "
-                             "backward-Euler Stokes step; `incremental`: previous pressure in the "
-                             "viscous solve (exact steady states); `split`: viscosity, then "
-                             "projection (steady states depend on the time step)");
+                             "`coupled`: the backward-Euler Stokes step (Uzawa passes of "
+                             "viscous and pressure solves); `incremental`: previous pressure in "
+                             "the viscous solve, one projection (steady states right but reached "
+                             "slowly at large νΔt/Δx²); `split`: viscosity, then projection "
+                             "(steady states depend on the time step)");
                   r.integer("max_passes", o.viscous_pressure.max_passes, Range::between(1, 100),
                             "", "coupled: most viscous + pressure passes per step");
                   r.number("pass_tolerance", o.viscous_pressure.pass_tolerance,
                            Range{0.0, 1.0, true, true}, "",
-                           "coupled: largest velocity change between passes over the largest "
-                           "speed at which the passes stop");
+                           "coupled: the passes stop once D/(1+D) times the largest "
+                           "divergence·Δx of the viscous velocity, over the largest speed, is "
+                           "below this (D = νΔt/Δx² of the more diffusive phase)");
               });
     v.number("cfl_number", o.time_step.cfl_number, Range::positive(), "cells",
              "cells a fluid particle may cross per step");

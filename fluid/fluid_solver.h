@@ -56,9 +56,9 @@ struct StepResult {
     SolveResult viscosity;        ///< viscous CG solves, summed likewise (0 iterations: skipped)
     double max_divergence = 0.0;  ///< max |∇·u| over the solved cells after projection, 1/s
     /// coupled: Uzawa–PCG iterations of the step (0 for the other schemes and for inviscid
-    /// flow); pass_change: the largest |D u|·Δx after them (before the final projection) over
-    /// the velocity scale (the largest face speed, at least |g|Δt); converged_passes: it met
-    /// ViscousPressureOptions::pass_tolerance.
+    /// flow); pass_change: after them (before the final projection), the largest |D u|·Δx over
+    /// the velocity scale (the largest face speed, at least |g|Δt), times D/(1 + D) (see
+    /// ViscousPressureOptions::pass_tolerance); converged_passes: it met pass_tolerance.
     int passes = 0;
     double pass_change = 0.0;
     bool converged_passes = true;
