@@ -1,5 +1,5 @@
 #pragma once
-/// \file Part B of `meniscus validate` (/work/shared/VALIDATION.md: two-phase flow with surface
+/// \file Part B of `meniscus validate` (two-phase flow with surface
 /// tension): B1 static drop (Laplace jump, spurious currents), B2 oscillating drop (Lamb's
 /// frequency and damping), B3 Rayleigh–Plateau (linear growth rate, pinch-off), B4 capillary
 /// wave (frequency against ω₀² = σk³/(ρ₁+ρ₂)), B5 merge and pinch scenes (component counts,

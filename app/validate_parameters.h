@@ -1,6 +1,6 @@
 #pragma once
 /// \file Parameters of `meniscus validate` part A: the paper's setups and numbers
-/// (/work/shared/VALIDATION.md part A, paper §4) and the choices of ours that the paper leaves
+/// (part A, paper §4) and the choices of ours that the paper leaves
 /// open. Shared by the runs (validate.cpp) and the report (validate_report.cpp).
 
 namespace meniscus::app::flow_validation {
