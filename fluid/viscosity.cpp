@@ -173,6 +173,21 @@ private:
         return m_mu_gas + (mu_liquid - m_mu_gas) * fraction;
     }
 
+    /// Calls visit(cell) for each of the (up to 4) grid cells around edge e of axis c, whose
+    /// other two axes are a and b.
+    template <typename Visit>
+    void for_each_edge_cell(const Index3& e, int a, int b, Visit&& visit) const {
+        for (int da = -1; da <= 0; ++da) {
+            for (int db = -1; db <= 0; ++db) {
+                Index3 cell = e;
+                cell[a] += da;
+                cell[b] += db;
+                if (m_mu.contains(cell[0], cell[1], cell[2]))
+                    visit(cell);
+            }
+        }
+    }
+
     void set_edge_weights(const WallOptions& walls, const Array3<double>& phi,
                           const PhaseOptions& phases) {
         for (int c = 0; c < 3; ++c) {
@@ -202,17 +217,10 @@ private:
                             // the cell faces next to the void.
                             double phi_sum = 0.0;
                             int count = 0;
-                            for (int da = -1; da <= 0; ++da) {
-                                for (int db = -1; db <= 0; ++db) {
-                                    Index3 cell = e;
-                                    cell[a] += da;
-                                    cell[b] += db;
-                                    if (phi.contains(cell[0], cell[1], cell[2])) {
-                                        phi_sum += phi(cell[0], cell[1], cell[2]);
-                                        ++count;
-                                    }
-                                }
-                            }
+                            for_each_edge_cell(e, a, b, [&](const Index3& cell) {
+                                phi_sum += phi(cell[0], cell[1], cell[2]);
+                                ++count;
+                            });
                             weight(i, j, k) =
                                 SHEAR_WEIGHT * fraction *
                                 blended_mu(phases.mu_liquid,
@@ -225,19 +233,12 @@ private:
                         double inverse_sum = 0.0;
                         int count = 0;
                         bool inviscid = false;
-                        for (int da = -1; da <= 0; ++da) {
-                            for (int db = -1; db <= 0; ++db) {
-                                Index3 cell = e;
-                                cell[a] += da;
-                                cell[b] += db;
-                                if (m_mu.contains(cell[0], cell[1], cell[2])) {
-                                    const double mu = m_mu(cell[0], cell[1], cell[2]);
-                                    inviscid |= mu == 0.0;
-                                    inverse_sum += inviscid ? 0.0 : 1.0 / mu;
-                                    ++count;
-                                }
-                            }
-                        }
+                        for_each_edge_cell(e, a, b, [&](const Index3& cell) {
+                            const double mu = m_mu(cell[0], cell[1], cell[2]);
+                            inviscid |= mu == 0.0;
+                            inverse_sum += inviscid ? 0.0 : 1.0 / mu;
+                            ++count;
+                        });
                         if (!inviscid) {
                             weight(i, j, k) = SHEAR_WEIGHT * fraction * count / inverse_sum;
                         }
