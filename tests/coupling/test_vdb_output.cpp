@@ -3,8 +3,13 @@
 
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/Interpolation.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <map>
+#include <string>
 
 namespace meniscus::coupling {
 namespace {
@@ -93,6 +98,232 @@ TEST(VdbOutput, RejectsBadOptions) {
     EXPECT_THROW(write_surface_vdb("x.vdb", mesh, options), std::invalid_argument);
     options.voxel_size = 0.1;
     EXPECT_THROW(write_surface_vdb("x.vdb", mesh, options), std::invalid_argument);
+}
+
+/// The grids of a VDB file by name.
+std::map<std::string, openvdb::GridBase::Ptr> read_grids(const std::string& path) {
+    openvdb::initialize();
+    openvdb::io::File file(path);
+    file.open();
+    std::map<std::string, openvdb::GridBase::Ptr> grids;
+    for (auto it = file.beginName(); it != file.endName(); ++it)
+        grids[it.gridName()] = file.readGrid(it.gridName());
+    file.close();
+    return grids;
+}
+
+openvdb::FloatGrid::Ptr float_grid(const std::map<std::string, openvdb::GridBase::Ptr>& grids,
+                                   const std::string& name) {
+    const auto it = grids.find(name);
+    return it == grids.end() ? nullptr : openvdb::gridPtrCast<openvdb::FloatGrid>(it->second);
+}
+
+tracker::SurfaceMesh sphere_mesh(const Eigen::Vector3d& centre, double radius, double edge) {
+    tracker::ImplicitMeshOptions options;
+    options.edge_length = edge;
+    return tracker::mesh_implicit_shape(*tracker::make_sphere(centre, radius), options);
+}
+
+/// Two separate spheres in one mesh.
+tracker::SurfaceMesh two_spheres(const Eigen::Vector3d& c0, const Eigen::Vector3d& c1,
+                                 double radius, double edge) {
+    const tracker::SurfaceMesh a = sphere_mesh(c0, radius, edge), b = sphere_mesh(c1, radius, edge);
+    std::vector<tracker::Vec3> positions = a.positions();
+    std::vector<tracker::Triangle> triangles;
+    for (int ti = 0; ti < a.num_triangles(); ++ti)
+        triangles.push_back(a.triangle(ti));
+    for (int ti = 0; ti < b.num_triangles(); ++ti) {
+        tracker::Triangle t = b.triangle(ti);
+        for (int& v : t)
+            v += a.num_vertices();
+        triangles.push_back(t);
+    }
+    positions.insert(positions.end(), b.positions().begin(), b.positions().end());
+    return tracker::SurfaceMesh(positions, triangles);
+}
+
+std::string temp_vdb(const std::string& name) {
+    return (std::filesystem::temp_directory_path() / ("meniscus_" + name + ".vdb")).string();
+}
+
+TEST(VdbOutput, GapNarrowerThanAVoxelStaysOutside) {
+    // Two spheres whose gap is 0.3, 0.6 and 1.5 voxels wide, centred on a plane of voxel centres
+    // (x = 0): inside-by-flood-fill (openvdb::tools::meshToLevelSet, used before) closed such a
+    // gap, making the voxel centres in it negative. Signed from the mesh, every voxel centre
+    // outside both spheres is positive and every one inside either (beyond the mesh's chord
+    // error) negative.
+    const double voxel = 0.01, radius = 0.1, edge = 0.005;
+    for (double gap_voxels : {0.3, 0.6, 1.5}) {
+        const double gap = gap_voxels * voxel;
+        const Eigen::Vector3d c0(-radius - 0.5 * gap, 0.0023, -0.0017);
+        const Eigen::Vector3d c1(radius + 0.5 * gap, 0.0023, -0.0017);
+        const tracker::SurfaceMesh mesh = two_spheres(c0, c1, radius, edge);
+        VdbOutputOptions options;
+        options.voxel_size = voxel;
+        const std::string path = temp_vdb("gap");
+        write_surface_vdb(path, mesh, options);
+        const auto grids = read_grids(path);
+        std::filesystem::remove(path);
+        const auto surface = float_grid(grids, "surface");
+        const auto density = float_grid(grids, "density");
+        ASSERT_TRUE(surface && density);
+        const auto acc = surface->getConstAccessor();
+        const auto dacc = density->getConstAccessor();
+        // The chord error of the inscribed mesh: ξ²/(8R), with margin.
+        const double chord = edge * edge / radius;
+        int in_gap = 0, wrong = 0;
+        const int n = static_cast<int>(std::ceil((radius + gap) / voxel)) + 2;
+        for (int i = -n; i <= n; ++i)
+            for (int j = -n; j <= n; ++j)
+                for (int k = -n; k <= n; ++k) {
+                    const Eigen::Vector3d x = voxel * Eigen::Vector3d(i, j, k);
+                    const double d0 = (x - c0).norm() - radius, d1 = (x - c1).norm() - radius;
+                    const float phi = acc.getValue(openvdb::Coord(i, j, k));
+                    const float fog = dacc.getValue(openvdb::Coord(i, j, k));
+                    if (d0 > 0.0 && d1 > 0.0) {
+                        const bool between = std::abs(x.x()) < 0.5 * gap + 1e-12;
+                        in_gap += between ? 1 : 0;
+                        if (!(phi > 0.0f) || !(fog < 0.5f))
+                            ++wrong;
+                    } else if (std::min(d0, d1) < -chord) {
+                        if (!(phi < 0.0f) || !(fog > 0.5f))
+                            ++wrong;
+                    }
+                }
+        EXPECT_GT(in_gap, 0) << "gap " << gap_voxels << " voxels: no voxel centre in it";
+        EXPECT_EQ(wrong, 0) << "gap " << gap_voxels << " voxels";
+    }
+}
+
+TEST(VdbOutput, DensityIsAStepCentredOnTheSurface) {
+    // A sphere: `density` is ½ at the mesh (sampled trilinearly at its vertices, within a
+    // quarter voxel of the surface for a ramp of 1, 2 or 4 voxels), 1 deep inside, 0 outside,
+    // and clamp(½ − φ/(ramp·h), 0, 1) of `surface` everywhere.
+    const Eigen::Vector3d centre(0.31, 0.27, 0.42);
+    const double radius = 0.2, voxel = 0.01;
+    const tracker::SurfaceMesh mesh = sphere_mesh(centre, radius, 0.01);
+    for (double ramp : {1.0, 2.0, 4.0}) {
+        VdbOutputOptions options;
+        options.voxel_size = voxel;
+        options.density_ramp_voxels = ramp;
+        const std::string path = temp_vdb("density");
+        write_surface_vdb(path, mesh, options);
+        const auto grids = read_grids(path);
+        std::filesystem::remove(path);
+        const auto surface = float_grid(grids, "surface");
+        const auto density = float_grid(grids, "density");
+        ASSERT_TRUE(surface && density);
+        EXPECT_EQ(density->getGridClass(), openvdb::GRID_FOG_VOLUME);
+        const openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> sample(
+            *density);
+        double worst = 0.0;
+        for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+            const tracker::Vec3& p = mesh.position(vi);
+            const double fog = sample.wsSample(openvdb::Vec3d(p.x(), p.y(), p.z()));
+            worst = std::max(worst, std::abs(fog - 0.5) * ramp);  // voxels off the surface
+        }
+        EXPECT_LT(worst, 0.25) << "ramp " << ramp;
+        const auto dacc = density->getConstAccessor();
+        for (auto it = surface->cbeginValueOn(); it; ++it) {
+            const double expected = std::clamp(0.5 - *it / (ramp * voxel), 0.0, 1.0);
+            ASSERT_NEAR(dacc.getValue(it.getCoord()), expected, 1e-6) << it.getCoord();
+        }
+        const openvdb::Coord middle = surface->transform().worldToIndexCellCentered(
+            openvdb::Vec3d(centre.x(), centre.y(), centre.z()));
+        EXPECT_FLOAT_EQ(dacc.getValue(middle), 1.0f);
+        EXPECT_TRUE(dacc.isValueOn(middle));
+        EXPECT_FLOAT_EQ(dacc.getValue(openvdb::Coord(200, 200, 200)), 0.0f);
+        EXPECT_FALSE(dacc.isValueOn(openvdb::Coord(200, 200, 200)));
+    }
+}
+
+TEST(VdbOutput, BubbleIsNegativeInsideAndLengthsAreScaled) {
+    // A bubble (gas inside, labels {0, 1}) written with inside_region 0 (the region the surface
+    // encloses) and lengths in millimetres: negative inside, density 1 inside, voxel size and
+    // distances × 1000.
+    const Eigen::Vector3d centre(0.0021, 0.0017, 0.0033);
+    const double radius = 0.001, voxel = 1e-4;
+    tracker::SurfaceMesh mesh = sphere_mesh(centre, radius, 1e-4);
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        mesh.set_labels(ti, tracker::LabelPair{0, 1});
+    VdbOutputOptions options;
+    options.voxel_size = voxel;
+    options.inside_region = 0;
+    options.length_scale = 1000.0;
+    const std::string path = temp_vdb("bubble");
+    write_surface_vdb(path, mesh, options);
+    const auto grids = read_grids(path);
+    std::filesystem::remove(path);
+    const auto surface = float_grid(grids, "surface");
+    const auto density = float_grid(grids, "density");
+    ASSERT_TRUE(surface && density);
+    EXPECT_NEAR(surface->voxelSize()[0], 0.1, 1e-12);
+    const openvdb::Vec3d centre_mm(1000 * centre.x(), 1000 * centre.y(), 1000 * centre.z());
+    const openvdb::Coord middle = surface->transform().worldToIndexCellCentered(centre_mm);
+    EXPECT_LT(surface->getConstAccessor().getValue(middle), 0.0f);
+    EXPECT_FLOAT_EQ(density->getConstAccessor().getValue(middle), 1.0f);
+    double worst = 0.0;
+    for (auto it = surface->cbeginValueOn(); it; ++it) {
+        const openvdb::Vec3d w = surface->indexToWorld(it.getCoord());
+        const double exact = (w - centre_mm).length() - 1000 * radius;  // mm
+        if (std::abs(exact) > 0.05) {
+            EXPECT_EQ(*it < 0.0f, exact < 0.0) << w;
+        }
+        worst = std::max(worst, std::abs(*it - exact));
+    }
+    EXPECT_LT(worst, 0.05);  // half a voxel, in mm
+}
+
+TEST(VdbOutput, FluidFieldsSitOnCellCentresInOutputUnits) {
+    // `vel` is the face velocities averaged to the cell centres (× length_scale), `pressure` the
+    // solver's array; voxel (i, j, k) of both is centred on fluid cell (i, j, k).
+    fluid::MacGrid grid(4, 3, 2, 0.5e-3, Eigen::Vector3d(1e-3, -2e-3, 0.5e-3));
+    for (int axis = 0; axis < 3; ++axis) {
+        fluid::Array3<double>& u = grid.velocity(axis);
+        for (int k = 0; k < u.nk(); ++k)
+            for (int j = 0; j < u.nj(); ++j)
+                for (int i = 0; i < u.ni(); ++i)
+                    u(i, j, k) = 0.01 * (axis + 1) * (i + 2 * j + 3 * k);
+    }
+    fluid::Array3<double> pressure(4, 3, 2, 0.0);
+    for (size_t n = 0; n < pressure.size(); ++n)
+        pressure[n] = 100.0 + static_cast<double>(n);
+    const tracker::SurfaceMesh mesh = sphere_mesh(Eigen::Vector3d(2e-3, -1.2e-3, 1e-3), 4e-4, 1e-4);
+    VdbOutputOptions options;
+    options.voxel_size = 1e-4;
+    options.length_scale = 1000.0;
+    const std::string path = temp_vdb("fluid_fields");
+    const VdbOutputInfo info = write_surface_vdb(path, mesh, options, {&grid, &pressure});
+    EXPECT_TRUE(info.velocity_written);
+    EXPECT_TRUE(info.pressure_written);
+    const auto grids = read_grids(path);
+    const auto vel = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grids.at("vel"));
+    const auto p = float_grid(grids, "pressure");
+    ASSERT_TRUE(vel && p);
+    for (int k = 0; k < 2; ++k)
+        for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 4; ++i) {
+                const openvdb::Coord c(i, j, k);
+                const Eigen::Vector3d x = 1000.0 * grid.cell_centre(i, j, k);
+                const openvdb::Vec3d w = vel->indexToWorld(c);
+                EXPECT_NEAR((Eigen::Vector3d(w.x(), w.y(), w.z()) - x).norm(), 0.0, 1e-9);
+                const openvdb::Vec3s v = vel->getConstAccessor().getValue(c);
+                EXPECT_NEAR(v.x(), 500.0 * (grid.u()(i, j, k) + grid.u()(i + 1, j, k)), 1e-4);
+                EXPECT_NEAR(v.y(), 500.0 * (grid.v()(i, j, k) + grid.v()(i, j + 1, k)), 1e-4);
+                EXPECT_NEAR(v.z(), 500.0 * (grid.w()(i, j, k) + grid.w()(i, j, k + 1)), 1e-4);
+                EXPECT_FLOAT_EQ(p->getConstAccessor().getValue(c),
+                                static_cast<float>(pressure(i, j, k)));
+                EXPECT_EQ(p->indexToWorld(c), w);
+            }
+    // Each can be turned off.
+    options.velocity = false;
+    options.pressure = false;
+    write_surface_vdb(path, mesh, options, {&grid, &pressure});
+    const auto without = read_grids(path);
+    EXPECT_EQ(without.count("vel"), 0u);
+    EXPECT_EQ(without.count("pressure"), 0u);
+    EXPECT_EQ(without.count("surface"), 1u);
+    std::filesystem::remove(path);
 }
 
 }  // namespace
