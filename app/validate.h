@@ -1,6 +1,6 @@
 #pragma once
 /// \file `meniscus validate`: runs the paper's geometric-flow validation cases
-/// (/work/shared/VALIDATION.md part A: A1 normal flow, A2 mean curvature, A3 Enright, A4 curl
+/// (docs/validation.md part A: A1 normal flow, A2 mean curvature, A3 Enright, A4 curl
 /// noise, A5 per-phase cost) through the collision-safe SurfaceTracker and writes, into one
 /// folder, `report.md` (our numbers beside the paper's, observed orders, per-phase seconds per
 /// step), `results.json` (every number and time series) and PNG plots made by

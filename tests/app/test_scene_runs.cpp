@@ -138,7 +138,7 @@ TEST(FlowScenes, A1ErrorInStatsIsTheFlowErrorsComputation) {
     ASSERT_EQ(lines.size(), 2u);
     const double t = lines[1]["time"];
     EXPECT_DOUBLE_EQ(t, 0.1);
-    // The same error from the written surface and VALIDATION.md A1's exact solution.
+    // The same error from the written surface and docs/validation.md A1's exact solution.
     const tracker::SurfaceMesh mesh = tracker::to_surface_mesh(
         tracker::read_mesh_file((fs::path(options.out_dir) / "surface_0001.ply").string()), "ply");
     tracker::TwoSphereNormalFlow flow;  // defaults: A1's spheres and speed

@@ -1,4 +1,4 @@
-// Physics of the shipped fluid scenes at coarse resolution (VALIDATION.md part B in the suite):
+// Physics of the shipped fluid scenes at coarse resolution (docs/validation.md part B, quick):
 // the oscillating drop's l = 2 frequency against Lamb's, the jet's Rayleigh–Plateau pinch-off,
 // and the volume of each phase, the component counts and intersection-freedom of the merge
 // scenes. Each test loads the shipped scene file and coarsens or shortens it (said where).
@@ -28,7 +28,7 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-/// VALIDATION.md B5: volume of each phase within 0.5 % over a run with volume correction on.
+/// docs/validation.md B5: volume of each phase within 0.5 % over a run with volume correction on.
 constexpr double PHASE_VOLUME_TOLERANCE = 0.005;
 
 std::string scene_path(const std::string& name) {
@@ -200,7 +200,7 @@ TEST(ScenePhysics, JetPinchQuickPinchesIntoDrops) {
     // Not before the linear phase is over.
     EXPECT_GT(pinch_time, std::log(1.0 / AMPLITUDE) / rate);
     // The liquid's volume (the enclosed one: the column is cut outside the domain), within
-    // VALIDATION.md's 0.5 %. Regression: the volume correction used to close only the previous
+    // docs/validation.md's 0.5 %. Regression: the volume correction used to close only the previous
     // step's gap, while the parts of the mesh outside the domain (moving with the clamped wall
     // velocity) changed the volume by a whole step's worth every step: 3.8 % drift. It now
     // also cancels the motion's own volume rate: measured 0.005 %.
