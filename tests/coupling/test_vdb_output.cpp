@@ -152,7 +152,7 @@ TEST(VdbOutput, GapNarrowerThanAVoxelStaysOutside) {
     // gap, making the voxel centres in it negative. Signed from the mesh, every voxel centre
     // outside both spheres is positive and every one inside either (beyond the mesh's chord
     // error) negative.
-    const double voxel = 0.01, radius = 0.1, edge = 0.005;
+    const double voxel = 0.01, radius = 0.1, edge = 0.01;
     for (double gap_voxels : {0.3, 0.6, 1.5}) {
         const double gap = gap_voxels * voxel;
         const Eigen::Vector3d c0(-radius - 0.5 * gap, 0.0023, -0.0017);
@@ -169,7 +169,7 @@ TEST(VdbOutput, GapNarrowerThanAVoxelStaysOutside) {
         ASSERT_TRUE(surface && density);
         const auto acc = surface->getConstAccessor();
         const auto dacc = density->getConstAccessor();
-        // The chord error of the inscribed mesh: ξ²/(8R), with margin.
+        // The chord error of the inscribed mesh, ξ²/(8R), with a margin of 8.
         const double chord = edge * edge / radius;
         int in_gap = 0, wrong = 0;
         const int n = static_cast<int>(std::ceil((radius + gap) / voxel)) + 2;

@@ -98,7 +98,7 @@ def read_sidecar(out_dir):
 
 def read_ply(path):
     """Vertices (n×3), triangles (m×3) and vertex velocities (n×3 or None) of a binary
-    little-endian or ASCII PLY triangle mesh."""
+    little-endian or ASCII PLY triangle mesh with its vertex element first (as meniscus writes)."""
     with open(path, "rb") as f:
         data = f.read()
     end = data.index(b"end_header\n") + len(b"end_header\n")
@@ -107,6 +107,8 @@ def read_ply(path):
     elements = []
     for line in lines:
         words = line.split()
+        if not words:
+            continue
         if words[0] == "element":
             elements.append({"name": words[1], "count": int(words[2]), "props": []})
         elif words[0] == "property":
