@@ -117,6 +117,16 @@ std::vector<std::pair<int, int>> wedge_pairs(const SurfaceMesh& mesh, int ei) {
     return pairs;
 }
 
+/// The fans of vi (vertex_fans()) when it is a live, interior, singular vertex; empty otherwise.
+std::vector<std::vector<int>> singular_vertex_fans(const SurfaceMesh& mesh, int vi) {
+    if (!mesh.vertex_alive(vi) || mesh.is_boundary_vertex(vi))
+        return {};
+    std::vector<std::vector<int>> fans = vertex_fans(mesh, vi);
+    if (fans.size() < 2)
+        fans.clear();
+    return fans;
+}
+
 Vec3 fan_centroid(const SurfaceMesh& mesh, const std::vector<int>& fan, int vi) {
     Vec3 sum = Vec3::Zero();
     int count = 0;
@@ -182,10 +192,8 @@ SeparationReport separate(SurfaceMesh& mesh, const SeparationOptions& options,
     std::unique_ptr<ElementHash> hash;
     const int vertex_count = mesh.num_vertices();
     for (int vi = 0; vi < vertex_count; ++vi) {
-        if (!mesh.vertex_alive(vi) || mesh.is_boundary_vertex(vi))
-            continue;
-        const std::vector<std::vector<int>> fans = vertex_fans(mesh, vi);
-        if (fans.size() < 2)
+        const std::vector<std::vector<int>> fans = singular_vertex_fans(mesh, vi);
+        if (fans.empty())
             continue;
         if (collision_safety && !hash)
             hash = std::make_unique<ElementHash>(mesh, xi);
@@ -268,10 +276,8 @@ EdgeManifoldReport make_edge_manifold(SurfaceMesh& mesh) {
     // 2. One copy per fan of every singular vertex.
     const int vertex_count = mesh.num_vertices();
     for (int vi = 0; vi < vertex_count; ++vi) {
-        if (!mesh.vertex_alive(vi) || mesh.is_boundary_vertex(vi))
-            continue;
-        const std::vector<std::vector<int>> fans = vertex_fans(mesh, vi);
-        if (fans.size() < 2)
+        const std::vector<std::vector<int>> fans = singular_vertex_fans(mesh, vi);
+        if (fans.empty())
             continue;
         for (size_t k = 1; k < fans.size(); ++k)
             report.added.push_back(
