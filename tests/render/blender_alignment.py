@@ -1,7 +1,9 @@
-"""Inside Blender: the volume lines up with the mesh. For frames of a `meniscus run`, imports the
-VDB as render.py does (moved by the sidecar's half-voxel `blender_offset`), turns its `surface`
-grid back into a mesh with Blender's own Volume to Mesh modifier (threshold 0), and compares that
-mesh's bounding box with the PLY's: every side within half a voxel.
+"""Inside Blender: the volume lines up with the mesh, on the right frames. Imports a
+`meniscus run`'s VDB frames as the animated volume sequence render.py makes for a whole run
+(moved by the sidecar's half-voxel `blender_offset`); for each FRAME checks that Blender loads
+fields_FRAME on frame FRAME (its own sequence import would put fields_N on frame N + 1), turns
+the `surface` grid back into a mesh with Blender's own Volume to Mesh modifier (threshold 0),
+and compares that mesh's bounding box with the PLY's: every side within half a voxel.
 
     blender -b --python-exit-code 1 --python tests/render/blender_alignment.py -- \
         RENDER_SCRIPT RUN_DIR FRAME...
@@ -32,18 +34,30 @@ def main():
     sidecar = render.read_sidecar(run_dir)
     voxel = sidecar["vdb"]["voxel_size"]
     failures = []
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    run_frames = list(range(sidecar.get("first_frame", 0),
+                            sidecar.get("first_frame", 0) + sidecar["frame_count"]))
+    volume = render.add_volume(run_dir, sidecar, run_frames, True, 1.0)
+    mesh = bpy.data.objects.new("surface from volume", bpy.data.meshes.new("v2m"))
+    bpy.context.scene.collection.objects.link(mesh)
+    modifier = mesh.modifiers.new("volume to mesh", "VOLUME_TO_MESH")
+    modifier.object = volume
+    modifier.grid_name = "surface"
+    modifier.threshold = 0.0
+    modifier.adaptivity = 0.0
     for frame in frames:
-        bpy.ops.wm.read_factory_settings(use_empty=True)
-        volume = render.add_volume(run_dir, sidecar, [frame], False, 1.0)
-        mesh = bpy.data.objects.new("surface from volume", bpy.data.meshes.new("v2m"))
-        bpy.context.scene.collection.objects.link(mesh)
-        modifier = mesh.modifiers.new("volume to mesh", "VOLUME_TO_MESH")
-        modifier.object = volume
-        modifier.grid_name = "surface"
-        modifier.threshold = 0.0
-        modifier.adaptivity = 0.0
         bpy.context.scene.frame_set(frame)
-        evaluated = mesh.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh()
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        grids = volume.evaluated_get(depsgraph).data.grids
+        grids.load()
+        loaded = os.path.basename(grids.frame_filepath)
+        expected = os.path.basename(render.frame_file(run_dir, sidecar, "fields_vdb", frame))
+        print("[ measured ] frame %d: Blender's volume sequence loads %s" % (frame, loaded))
+        if loaded != expected:
+            failures.append("frame %d: the volume sequence loads %s, not %s" %
+                            (frame, loaded, expected))
+            continue
+        evaluated = mesh.evaluated_get(depsgraph).to_mesh()
         count = len(evaluated.vertices)
         co = np.empty(3 * count)
         evaluated.vertices.foreach_get("co", co)
