@@ -1,9 +1,10 @@
 """Inside Blender: the volume lines up with the mesh, on the right frames. Imports a
-`meniscus run`'s VDB frames as the animated volume sequence render.py makes for a whole run
-(moved by the sidecar's half-voxel `blender_offset`); for each FRAME checks that Blender loads
-fields_FRAME on frame FRAME (its own sequence import would put fields_N on frame N + 1), turns
-the `surface` grid back into a mesh with Blender's own Volume to Mesh modifier (threshold 0),
-and compares that mesh's bounding box with the PLY's: every side within half a voxel.
+`meniscus run`'s frames as render.py does for a whole run — one mesh object per PLY, an animated
+volume sequence moved by the sidecar's half-voxel `blender_offset` — and for each FRAME checks
+that only the mesh of that frame is shown and that Blender loads fields_FRAME (its own
+sequence import would put fields_N on frame N + 1); then turns the `surface` grid back into a
+mesh with Blender's own Volume to Mesh modifier (threshold 0) and compares that mesh's bounding
+box with the PLY's: every side within half a voxel.
 
     blender -b --python-exit-code 1 --python tests/render/blender_alignment.py -- \
         RENDER_SCRIPT RUN_DIR FRAME...
@@ -37,7 +38,7 @@ def main():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     run_frames = list(range(sidecar.get("first_frame", 0),
                             sidecar.get("first_frame", 0) + sidecar["frame_count"]))
-    volume = render.add_volume(run_dir, sidecar, run_frames, True, 1.0)
+    _, surfaces, volume = render.import_frames(run_dir, sidecar, run_frames, True, True, 1.0)
     mesh = bpy.data.objects.new("surface from volume", bpy.data.meshes.new("v2m"))
     bpy.context.scene.collection.objects.link(mesh)
     modifier = mesh.modifiers.new("volume to mesh", "VOLUME_TO_MESH")
@@ -50,6 +51,10 @@ def main():
         depsgraph = bpy.context.evaluated_depsgraph_get()
         grids = volume.evaluated_get(depsgraph).data.grids
         grids.load()
+        shown = sorted(obj.name for obj in surfaces.values() if not obj.hide_render)
+        print("[ measured ] frame %d: meshes shown %s" % (frame, shown))
+        if shown != ["surface_%04d" % frame]:
+            failures.append("frame %d: meshes shown %s" % (frame, shown))
         loaded = os.path.basename(grids.frame_filepath)
         expected = os.path.basename(render.frame_file(run_dir, sidecar, "fields_vdb", frame))
         print("[ measured ] frame %d: Blender's volume sequence loads %s" % (frame, loaded))

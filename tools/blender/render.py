@@ -372,6 +372,26 @@ def projected_box(scene, camera, xyz):
     return [min(xs), min(ys), max(xs), max(ys)]
 
 
+def import_frames(out_dir, sidecar, frames, mesh, volume, density_scale):
+    """The run's `frames` as an animation: one mesh object per PLY frame, each shown only on its
+    own frame (when `mesh`), and the VDB frames as one volume sequence on the same frames (when
+    `volume`). Returns ({frame: vertex positions}, {frame: mesh object}, the volume object or
+    None)."""
+    meshes, objects, volume_object = {}, {}, None
+    if mesh:
+        material = water_material(sidecar.get("inside", "liquid"))
+        for frame in frames:
+            xyz, triangles, velocity = read_ply(frame_file(out_dir, sidecar, "surface_ply", frame))
+            obj = mesh_object("surface_%04d" % frame, xyz, triangles, velocity, material)
+            if len(frames) > 1:
+                show_only_on_frame(obj, frame, frames[0], frames[-1])
+            meshes[frame] = xyz
+            objects[frame] = obj
+    if volume:
+        volume_object = add_volume(out_dir, sidecar, frames, len(frames) > 1, density_scale)
+    return meshes, objects, volume_object
+
+
 def main():
     args = parse_arguments(sys.argv)
     out_dir = os.path.abspath(args.out_dir)
@@ -394,18 +414,8 @@ def main():
     add_sun(scene)
     lo, hi = bounding_box(out_dir, sidecar, all_frames)
     camera = place_camera(scene, lo, hi)
-    meshes = {}
-    if not args.no_mesh:
-        material = water_material(sidecar.get("inside", "liquid"))
-        for frame in frames:
-            xyz, triangles, velocity = read_ply(frame_file(out_dir, sidecar, "surface_ply", frame))
-            obj = mesh_object("surface_%04d" % frame, xyz, triangles, velocity, material)
-            if len(frames) > 1:
-                show_only_on_frame(obj, frame, frames[0], frames[-1])
-            meshes[frame] = xyz
-    if args.volume:
-        add_volume(out_dir, sidecar, frames, len(frames) > 1,
-                   VOLUME_OPTICAL_DEPTH / float(np.min(hi - lo)))
+    meshes, _, _ = import_frames(out_dir, sidecar, frames, not args.no_mesh, args.volume,
+                                 VOLUME_OPTICAL_DEPTH / float(np.min(hi - lo)))
 
     report = {"width": args.width, "height": args.height, "frames": {}}
     for frame in frames:
