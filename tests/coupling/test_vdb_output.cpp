@@ -146,6 +146,17 @@ std::string temp_vdb(const std::string& name) {
     return (std::filesystem::temp_directory_path() / ("meniscus_" + name + ".vdb")).string();
 }
 
+/// The grids write_surface_vdb() writes for `mesh` (through a temporary file named by `name`).
+std::map<std::string, openvdb::GridBase::Ptr> written_grids(const tracker::SurfaceMesh& mesh,
+                                                            const VdbOutputOptions& options,
+                                                            const std::string& name) {
+    const std::string path = temp_vdb(name);
+    write_surface_vdb(path, mesh, options);
+    auto grids = read_grids(path);
+    std::filesystem::remove(path);
+    return grids;
+}
+
 TEST(VdbOutput, GapNarrowerThanAVoxelStaysOutside) {
     // Two spheres whose gap is 0.3, 0.6 and 1.5 voxels wide, centred on a plane of voxel centres
     // (x = 0): inside-by-flood-fill (openvdb::tools::meshToLevelSet, used before) closed such a
@@ -160,10 +171,7 @@ TEST(VdbOutput, GapNarrowerThanAVoxelStaysOutside) {
         const tracker::SurfaceMesh mesh = two_spheres(c0, c1, radius, edge);
         VdbOutputOptions options;
         options.voxel_size = voxel;
-        const std::string path = temp_vdb("gap");
-        write_surface_vdb(path, mesh, options);
-        const auto grids = read_grids(path);
-        std::filesystem::remove(path);
+        const auto grids = written_grids(mesh, options, "gap");
         const auto surface = float_grid(grids, "surface");
         const auto density = float_grid(grids, "density");
         ASSERT_TRUE(surface && density);
@@ -206,10 +214,7 @@ TEST(VdbOutput, DensityIsAStepCentredOnTheSurface) {
         VdbOutputOptions options;
         options.voxel_size = voxel;
         options.density_ramp_voxels = ramp;
-        const std::string path = temp_vdb("density");
-        write_surface_vdb(path, mesh, options);
-        const auto grids = read_grids(path);
-        std::filesystem::remove(path);
+        const auto grids = written_grids(mesh, options, "density");
         const auto surface = float_grid(grids, "surface");
         const auto density = float_grid(grids, "density");
         ASSERT_TRUE(surface && density);
@@ -250,10 +255,7 @@ TEST(VdbOutput, BubbleIsNegativeInsideAndLengthsAreScaled) {
     options.voxel_size = voxel;
     options.inside_region = 0;
     options.length_scale = 1000.0;
-    const std::string path = temp_vdb("bubble");
-    write_surface_vdb(path, mesh, options);
-    const auto grids = read_grids(path);
-    std::filesystem::remove(path);
+    const auto grids = written_grids(mesh, options, "bubble");
     const auto surface = float_grid(grids, "surface");
     const auto density = float_grid(grids, "density");
     ASSERT_TRUE(surface && density);
