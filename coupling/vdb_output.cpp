@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <vector>
@@ -112,9 +113,151 @@ void fill_leaf_signs(openvdb::FloatTree& tree, float background) {
     }
 }
 
-/// The `surface` level set: signed band values, then signs outside the band.
+/// Sweeps of vertex pinning: each visits every vertex; they stop early once none changes.
+constexpr int MAX_PIN_SWEEPS = 8;
+/// Pinning passes per vertex and sweep (the `surface` and the `density` sample in turn).
+constexpr int MAX_PIN_PASSES = 4;
+/// A sample counts as off target only beyond target × (1 + this): float storage rounds.
+constexpr double PIN_SLACK = 1e-4;
+
+/// The eight voxels around a point and their trilinear weights (OpenVDB's convention: voxel
+/// (i, j, k) holds the value at (i, j, k) · h), with the values of a grid there.
+struct VoxelStencil {
+    std::array<openvdb::Coord, 8> coords;
+    std::array<double, 8> weights{};
+    std::array<double, 8> values{};
+};
+
+VoxelStencil stencil_at(const tracker::Vec3& x, double voxel_size) {
+    const tracker::Vec3 index = x / voxel_size;
+    const std::array<double, 3> floor{std::floor(index.x()), std::floor(index.y()),
+                                      std::floor(index.z())};
+    VoxelStencil stencil;
+    for (int corner = 0; corner < 8; ++corner) {
+        double w = 1.0;
+        std::array<int, 3> ijk{};
+        for (int axis = 0; axis < 3; ++axis) {
+            const int bit = (corner >> axis) & 1;
+            const double f = index[axis] - floor[static_cast<size_t>(axis)];
+            w *= bit ? f : 1.0 - f;
+            ijk[static_cast<size_t>(axis)] = static_cast<int>(floor[static_cast<size_t>(axis)]) + bit;
+        }
+        stencil.coords[static_cast<size_t>(corner)] = openvdb::Coord(ijk[0], ijk[1], ijk[2]);
+        stencil.weights[static_cast<size_t>(corner)] = w;
+    }
+    return stencil;
+}
+
+/// The trilinear sample of the stencil's values, each clamped to [−limit, limit].
+double clamped_sample(const VoxelStencil& stencil, double limit) {
+    double sum = 0.0;
+    for (size_t n = 0; n < 8; ++n)
+        sum += stencil.weights[n] * std::clamp(stencil.values[n], -limit, limit);
+    return sum;
+}
+
+/// If the sample of the values clamped at ±limit is farther than `target` from 0, scales down
+/// the values of the sample's sign (after clamping them at ±limit, which keeps the sample) by
+/// the factor in (0, 1) that brings it to ±target. Signs never change. Returns whether it did.
+bool pin_sample(VoxelStencil& stencil, double limit, double target) {
+    const double sample = clamped_sample(stencil, limit);
+    if (!(std::abs(sample) > target * (1.0 + PIN_SLACK)))
+        return false;
+    const double sign = sample > 0.0 ? 1.0 : -1.0;
+    double same = 0.0;
+    for (size_t n = 0; n < 8; ++n) {
+        double& v = stencil.values[n];
+        if (sign * v > 0.0) {
+            v = sign * std::min(std::abs(v), limit);
+            same += stencil.weights[n] * v;
+        }
+    }
+    // sample = same + other with sign·other ≤ 0 < target < sign·sample, so 0 < factor < 1.
+    const double factor = (sign * target - (sample - same)) / same;
+    for (double& v : stencil.values)
+        if (sign * v > 0.0)
+            v *= factor;
+    return true;
+}
+
+/// The larger offset from 0 of the stencil's `surface` sample and its `density` ramp sample.
+double sample_offset(const VoxelStencil& stencil, double ramp_limit) {
+    return std::max(std::abs(clamped_sample(stencil, std::numeric_limits<double>::infinity())),
+                    std::abs(clamped_sample(stencil, ramp_limit)));
+}
+
+/// Vertex pinning of `surface` (band values set, before the signs are filled; see the file
+/// comment of vdb_output.h). Every stencil voxel is in the band: a vertex is within √3/2 voxel
+/// of its eight voxel centres and the band half width is ≥ 1 voxel. Values near folds sharper
+/// than a voxel are no longer exact distances afterwards (only their magnitudes shrink).
+void pin_vertices(openvdb::FloatGrid& surface, const tracker::SurfaceMesh& mesh,
+                  const VdbOutputOptions& options, VdbOutputInfo& info) {
+    const double h = options.voxel_size;
+    const double unit = h * options.length_scale;  // one voxel in output units
+    const double target = options.vertex_pin_voxels * unit;
+    const double ramp_limit = options.density ? 0.5 * options.density_ramp_voxels * unit
+                                              : std::numeric_limits<double>::infinity();
+    auto acc = surface.getAccessor();
+    auto load = [&](int vi) {
+        VoxelStencil stencil = stencil_at(mesh.position(vi), h);
+        for (size_t n = 0; n < 8; ++n)
+            stencil.values[n] = acc.getValue(stencil.coords[n]);
+        return stencil;
+    };
+    std::vector<int> vertices;
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        if (mesh.vertex_alive(vi))
+            vertices.push_back(vi);
+    for (int vi : vertices)
+        info.vertex_offset_before_voxels =
+            std::max(info.vertex_offset_before_voxels, sample_offset(load(vi), ramp_limit) / unit);
+    if (options.pin_vertices) {
+        std::vector<char> pinned(static_cast<size_t>(mesh.num_vertices()), 0);
+        std::vector<openvdb::Coord> changed_voxels;
+        for (int sweep = 0; sweep < MAX_PIN_SWEEPS; ++sweep) {
+            bool changed = false;
+            for (int vi : vertices) {
+                VoxelStencil stencil = load(vi);
+                bool vertex_changed = false;
+                for (int pass = 0; pass < MAX_PIN_PASSES; ++pass) {
+                    const bool a = pin_sample(stencil, std::numeric_limits<double>::infinity(),
+                                              target);
+                    const bool b = pin_sample(stencil, ramp_limit, target);
+                    if (!a && !b)
+                        break;
+                    vertex_changed = true;
+                }
+                if (!vertex_changed)
+                    continue;
+                changed = true;
+                pinned[static_cast<size_t>(vi)] = 1;
+                for (size_t n = 0; n < 8; ++n) {
+                    const float old_value = acc.getValue(stencil.coords[n]);
+                    float value = static_cast<float>(stencil.values[n]);
+                    if (value == 0.0f && old_value != 0.0f)  // keep the sign through rounding
+                        value = std::copysign(std::numeric_limits<float>::min(), old_value);
+                    if (value != old_value) {
+                        acc.setValueOnly(stencil.coords[n], value);
+                        changed_voxels.push_back(stencil.coords[n]);
+                    }
+                }
+            }
+            if (!changed)
+                break;
+        }
+        std::sort(changed_voxels.begin(), changed_voxels.end());
+        info.voxels_pinned = static_cast<long long>(
+            std::unique(changed_voxels.begin(), changed_voxels.end()) - changed_voxels.begin());
+        info.vertices_pinned = std::count(pinned.begin(), pinned.end(), 1);
+    }
+    for (int vi : vertices)
+        info.vertex_offset_after_voxels =
+            std::max(info.vertex_offset_after_voxels, sample_offset(load(vi), ramp_limit) / unit);
+}
+
+/// The `surface` level set: signed band values, vertex pinning, then signs outside the band.
 openvdb::FloatGrid::Ptr surface_grid(const tracker::SurfaceMesh& mesh,
-                                     const VdbOutputOptions& options) {
+                                     const VdbOutputOptions& options, VdbOutputInfo& info) {
     const double h = options.voxel_size;
     const double s = options.length_scale;
     const float background = static_cast<float>(options.half_width_voxels * h * s);
@@ -135,6 +278,7 @@ openvdb::FloatGrid::Ptr surface_grid(const tracker::SurfaceMesh& mesh,
         if (std::abs(phi) < background)
             acc.setValue(openvdb::Coord(v.ijk[0], v.ijk[1], v.ijk[2]), phi);
     }
+    pin_vertices(*surface, mesh, options, info);
     fill_leaf_signs(surface->tree(), background);
     // Tiles between leaves: OpenVDB's sign propagation from the (now filled) leaves.
     constexpr openvdb::Index TILE_LEVELS_ONLY = 1;
@@ -178,6 +322,8 @@ void VdbOutputOptions::validate() const {
     if (!(density_ramp_voxels > 0.0) || !(density_ramp_voxels <= 2.0 * half_width_voxels))
         throw std::invalid_argument(
             "density_ramp_voxels: expected a number > 0 and <= 2 * half_width_voxels");
+    if (!(vertex_pin_voxels > 0.0) || !(vertex_pin_voxels <= 0.5))
+        throw std::invalid_argument("vertex_pin_voxels: expected a number > 0 and <= 0.5");
     if (!(length_scale > 0.0) || !std::isfinite(length_scale))
         throw std::invalid_argument("length_scale: expected a number > 0");
 }
@@ -190,7 +336,7 @@ VdbOutputInfo write_surface_vdb(const std::string& path, const tracker::SurfaceM
     initialize_openvdb_once();
 
     VdbOutputInfo info;
-    openvdb::FloatGrid::Ptr surface = surface_grid(mesh, options);
+    openvdb::FloatGrid::Ptr surface = surface_grid(mesh, options, info);
     info.surface_active_voxels = static_cast<long long>(surface->activeVoxelCount());
     openvdb::GridPtrVec grids{surface};
     if (options.density) {

@@ -6,7 +6,17 @@
 ///    surface — in VdbOutputOptions::inside_region, the region the mesh encloses. Band voxels are
 ///    signed by the exact inside/outside test against the mesh (signed_band(), mesh_band.h, the
 ///    same rule as the coupling step's φ; no flood fill, so a gap narrower than a voxel stays
-///    outside); values outside the band keep the sign of the band next to them (±background);
+///    outside); values outside the band keep the sign of the band next to them (±background).
+///    Vertex pinning (VdbOutputOptions::pin_vertices, on by default): the band holds exact
+///    distances, but where the mesh folds more sharply than a voxel (e.g. the tip of a thin air
+///    slit a merge has just zipped, all eight voxel centres around a vertex on one side) no grid
+///    of exact distances interpolates to 0 at the mesh. So, for each mesh vertex whose trilinear
+///    sample of `surface` — or of `density`'s clamped ramp — is more than vertex_pin_voxels off
+///    zero, the magnitudes of those of its eight voxel values that have the sample's sign are
+///    scaled down until the sample is vertex_pin_voxels off (a few sweeps, since vertices share
+///    voxels). Signs never change (they stay the exact inside/outside test) and magnitudes only
+///    shrink, so values within about a voxel of such folds are no longer exact distances;
+///    elsewhere (all vertices already within vertex_pin_voxels) nothing changes;
 ///  - `density`: fog volume in [0, 1] centred on the surface: an anti-aliased step
 ///    clamp(½ − φ / (ramp · h), 0, 1) (h the voxel size), whose ½ isosurface is the mesh, 1
 ///    deep inside, 0 (inactive) outside: the grid renderers such as Blender shade by default;
@@ -40,6 +50,12 @@ struct VdbOutputOptions {
     /// Output length units per metre (1000 writes millimetres): scales the transforms, the
     /// distances of `surface` and the velocities of `vel`; > 0.
     double length_scale = 1.0;
+    /// Vertex pinning (see the file comment): every mesh vertex's trilinear sample of `surface`
+    /// and of `density` ends within vertex_pin_voxels of the surface, at the price of exact
+    /// distances near folds sharper than a voxel.
+    bool pin_vertices = true;
+    /// Target of the pinning, in voxels, in (0, 0.5].
+    double vertex_pin_voxels = 0.2;
     /// The region label (tracker::LabelPair) the surface encloses: `surface` is negative and
     /// `density` 1 there.
     int inside_region = 1;
@@ -50,6 +66,13 @@ struct VdbOutputOptions {
 struct VdbOutputInfo {
     long long surface_active_voxels = 0;
     long long density_active_voxels = 0;
+    /// Largest offset from the surface of a mesh vertex's trilinear samples (of `surface`, and
+    /// of `density`'s ramp when written), in voxels, before / after vertex pinning (equal when
+    /// pinning is off).
+    double vertex_offset_before_voxels = 0.0;
+    double vertex_offset_after_voxels = 0.0;
+    long long vertices_pinned = 0;  ///< vertices whose samples were pinned
+    long long voxels_pinned = 0;    ///< `surface` voxels whose magnitude pinning shrank
     bool velocity_written = false;
     bool pressure_written = false;
 };
