@@ -6,11 +6,12 @@ python3-openvdb, through /usr/bin/python3) — and checks what a renderer relies
 - every PLY is closed, edge-manifold and consistently oriented (each directed edge once, its
   reverse once; one fan of triangles around every vertex), carries vertex velocities, and
   encloses the volume stats.jsonl records (SI) in the sidecar's unit;
-- every VDB holds the sidecar's grids; `surface` is a level set whose trilinear samples at the
-  PLY's vertices are within a quarter voxel of zero and `density`'s within a quarter voxel of ½
-  (in voxels of offset), at every vertex whose incident triangles' normals stay within 90° of
-  each other — everywhere except at the folds of a neck freshly zipped by a merge, which a grid
-  can only round off: there, within 0.75 voxel;
+- every VDB holds the sidecar's grids; `surface` is a level set whose trilinear samples at
+  every PLY vertex are within a quarter voxel of zero (issue #35 asks for half a voxel) and
+  `density`'s within a quarter voxel of ½ (in voxels of offset) — at the folds of a neck freshly
+  zipped by a merge (vertices whose incident triangles' normals differ by more than 90°) too,
+  where exact distances alone are up to 0.58 voxel off and the writer's vertex pinning brings
+  them in (docs/validation.md, part C); the folds' numbers are printed apart;
 - `vel` and `pressure` sit on the fluid's cell centres.
 
 Prints the measured numbers per frame. Usage: check_run_files.py RUN_DIR
@@ -25,8 +26,7 @@ import meshio
 import numpy as np
 import pyopenvdb as vdb
 
-SMOOTH_BOUND_VOXELS = 0.25
-CREASE_BOUND_VOXELS = 0.75
+BOUND_VOXELS = 0.25
 CREASE_DEGREES = 90.0
 VOLUME_RELATIVE = 1e-9
 
@@ -162,10 +162,9 @@ def main(run_dir):
         print("[ measured ] frame %2d: %4d vertices (%2d on folds), volume %.6f mm3; |phi| at "
               "vertices max %.3f voxel (folds %.3f), density 0.5-offset max %.3f voxel (folds "
               "%.3f)" % (frame, len(points), crease.sum(), volume, s_phi, c_phi, s_den, c_den))
-        check(s_phi <= SMOOTH_BOUND_VOXELS and s_den <= SMOOTH_BOUND_VOXELS,
-              "%s: |phi| %.3f / density offset %.3f voxel at smooth vertices" % (path, s_phi, s_den))
-        check(c_phi <= CREASE_BOUND_VOXELS and c_den <= CREASE_BOUND_VOXELS,
-              "%s: |phi| %.3f / density offset %.3f voxel at folds" % (path, c_phi, c_den))
+        check(phi.max() <= BOUND_VOXELS and offset.max() <= BOUND_VOXELS,
+              "%s: |phi| %.3f / density offset %.3f voxel at a vertex (folds: %.3f / %.3f)" %
+              (path, phi.max(), offset.max(), c_phi, c_den))
 
         vel, pressure = by_name["vel"], by_name["pressure"]
         check(abs(vel.transform.voxelSize()[0] - cell) < 1e-9, "%s: vel voxel size" % path)
