@@ -10,7 +10,8 @@ cd "$(dirname "$0")"
 DEFAULT_SCENE=scenes/drop_merge.json
 BUILD_DIR=${MENISCUS_BUILD_DIR:-build}
 PACKAGES=(cmake ninja-build g++ ccache libeigen3-dev libtbb-dev libopenvdb-dev libboost-iostreams-dev
-          nlohmann-json3-dev libgtest-dev libbenchmark-dev libgmp-dev python3-matplotlib python3-numpy)
+          nlohmann-json3-dev libgtest-dev libbenchmark-dev libgmp-dev python3-matplotlib python3-numpy
+          blender python3-openvdb python3-meshio python3-pil)
 
 install_missing() {
   local missing=()

@@ -1,6 +1,6 @@
 /// Coupled runs sampled every step, measurements on the mesh (volume moments, Fourier modes of
 /// a column's radius and of a surface's height), least-squares fits of damped oscillations and
-/// of exponential growth, and the analytic references of VALIDATION.md part B.
+/// of exponential growth, and the analytic references of docs/validation.md part B.
 
 #include "app/fluid_measures.h"
 

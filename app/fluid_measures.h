@@ -1,5 +1,5 @@
 #pragma once
-/// \file Measuring two-phase runs (VALIDATION.md part B; used by `meniscus validate` and the
+/// \file Measuring two-phase runs (docs/validation.md part B; used by `meniscus validate` and the
 /// scene physics tests): coupled runs sampled every step, exact volume moments and Fourier modes
 /// of the mesh, least-squares fits of damped oscillations and of growth from rest. The analytic
 /// references are in fluid_references.h.

@@ -1,5 +1,6 @@
 #include "app/run.h"
 
+#include "app/frame_output.h"
 #include "app/progress.h"
 #include "coupling/simulation.h"
 #include "coupling/vdb_output.h"
@@ -35,8 +36,6 @@ using Clock = std::chrono::steady_clock;
 
 /// Violations listed in an error message before "and N more".
 constexpr size_t MAX_LISTED_VIOLATIONS = 5;
-/// Frames are numbered with this many digits.
-constexpr int FRAME_DIGITS = 4;
 /// Geometric flows: a step that ends this close (fraction of /time/dt) to a stop lands on it.
 constexpr double TIME_SNAP_FRACTION = 1e-9;
 /// Geometric flows: the run stops (RunResult::stalled) after this many consecutive steps that
@@ -46,12 +45,6 @@ constexpr double STALL_FRACTION = 1e-6;
 
 double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-std::string frame_path(const std::string& dir, const char* stem, int frame, const char* ext) {
-    char name[64];
-    std::snprintf(name, sizeof name, "%s_%0*d.%s", stem, FRAME_DIGITS, frame, ext);
-    return (std::filesystem::path(dir) / name).string();
 }
 
 /// A geometric flow (paper §4) ready to step: the stepper owns its step control; `field` keeps
@@ -248,30 +241,31 @@ struct FrameWork {
     double volume_remeshing = 0.0, volume_motion = 0.0, volume_collisions = 0.0;
 };
 
+/// The run's output folder: removes an earlier run's files (frame_output.h), writes each frame's
+/// files and keeps the sidecar meniscus.json up to date (frames written, complete or not).
 class FrameWriter {
 public:
-    FrameWriter(const Scene& scene, const std::string& dir) : m_scene(scene), m_dir(dir) {
-        std::filesystem::create_directories(dir);
-        m_stats.open((std::filesystem::path(dir) / "stats.jsonl").string(), std::ios::trunc);
+    /// `frames`: the frames the run will write after frame 0.
+    FrameWriter(const Scene& scene, const RunOptions& options, int frames)
+        : m_scene(scene), m_dir(options.out_dir), m_format(frame_format(scene)), m_frames(frames) {
+        const std::vector<std::string> removed = remove_earlier_run(m_dir);
+        if (!removed.empty() && !options.quiet)
+            std::fprintf(stderr, "%s: removed %zu files of an earlier run (%s ... %s)\n",
+                         m_dir.c_str(), removed.size(), removed.front().c_str(),
+                         removed.back().c_str());
+        std::filesystem::create_directories(m_dir);
+        m_stats.open((std::filesystem::path(m_dir) / STATS_NAME).string(), std::ios::trunc);
         if (!m_stats)
-            throw std::runtime_error(dir + "/stats.jsonl: cannot open for writing");
-        m_vdb.voxel_size = scene.output.voxel_size > 0.0 ? scene.output.voxel_size
-                                                         : 0.5 * scene.surface.edge_length;
-        m_vdb.half_width_voxels = scene.output.half_width_voxels;
+            throw std::runtime_error(m_dir + "/" + STATS_NAME + ": cannot open for writing");
     }
 
-    /// Writes the frame's files; returns seconds spent.
+    /// Writes the frame's files, then the sidecar; returns seconds spent.
     double write(int frame, const SurfaceMesh& mesh, const std::vector<Vec3>& velocities,
                  const coupling::FluidFields& fluid = {}) {
         const auto start = Clock::now();
-        const OutputOptions& o = m_scene.output;
-        if (o.ply)
-            tracker::write_ply(frame_path(m_dir, "surface", frame, "ply"), mesh,
-                               o.ply_velocity ? &velocities : nullptr);
-        if (o.obj)
-            tracker::write_obj(frame_path(m_dir, "surface", frame, "obj"), mesh);
-        if (o.vdb)
-            coupling::write_surface_vdb(frame_path(m_dir, "fields", frame, "vdb"), mesh, m_vdb);
+        write_frame_files(m_dir, frame, m_format, mesh, velocities, fluid);
+        write_run_sidecar(
+            m_dir, run_sidecar(m_scene, m_format, frame + 1, m_frames + 1, frame == m_frames));
         return seconds_since(start);
     }
 
@@ -283,8 +277,9 @@ public:
 private:
     const Scene& m_scene;
     std::string m_dir;
+    FrameFormat m_format;
+    int m_frames = 0;
     std::ofstream m_stats;
-    coupling::VdbOutputOptions m_vdb;
 };
 
 nlohmann::json frame_stats(int frame, double time, double dt, long long steps,
@@ -572,7 +567,7 @@ RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
     const int frames = options.frames > 0 ? options.frames : scene.time.frames;
     const double frame_dt = scene.time.end / scene.time.frames;
     const double end_time = frame_dt * frames;
-    FrameWriter writer(scene, options.out_dir);
+    FrameWriter writer(scene, options, frames);
     Progress progress(stderr, options.quiet);
     const auto fields = [&]() {
         return coupling::FluidFields{&sim.fluid().grid(), &sim.fluid().pressure()};
@@ -663,7 +658,7 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
         exact.check_initial(mesh, tracker.characteristic_length());
     const GeometricFlow flow = make_flow(scene.flow);
 
-    FrameWriter writer(scene, options.out_dir);
+    FrameWriter writer(scene, options, frames);
     Progress progress(stderr, options.quiet);
     std::vector<Vec3> velocities(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
     const auto write_stats = [&](int frame, double t, double dt, long long steps,

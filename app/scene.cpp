@@ -328,6 +328,16 @@ void visit_fields(V& v, OutputOptions& o) {
              "VDB voxel size; 0 = half of /surface/edge_length");
     v.number("half_width_voxels", o.half_width_voxels, Range::at_least(1.0), "voxels",
              "narrow-band half width of the `surface` level set");
+    v.number("density_ramp_voxels", o.density_ramp_voxels, Range::positive(), "voxels",
+             "width of the `density` step across the surface (0.5 on the surface, 1 inside, "
+             "0 outside); at most 2 · half_width_voxels");
+    v.boolean("vdb_velocity", o.vdb_velocity,
+              "fluid scenes: write the grid `vel` (cell-centred velocity) into the VDB");
+    v.boolean("vdb_pressure", o.vdb_pressure,
+              "fluid scenes: write the grid `pressure` (Pa, cell-centred) into the VDB");
+    v.choice("length_unit", o.length_unit, {"m", "cm", "mm"},
+             "unit of every length written: PLY/OBJ positions and velocities (unit/s), VDB "
+             "transforms, distances and `vel`; recorded in meniscus.json (stats.jsonl stays SI)");
 }
 
 template <typename V>
@@ -635,6 +645,10 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
                 "moves new vertices onto the exact surface)");
         if (scene.surface.open && scene.flow.type == "fluid")
             throw SceneError("/surface/open: fluid scenes need a closed surface");
+        if (scene.output.density_ramp_voxels > 2.0 * scene.output.half_width_voxels)
+            throw SceneError(
+                "/output/density_ramp_voxels: expected at most 2 · "
+                "/output/half_width_voxels (the ramp must fit in the band)");
         if (!scene.surface.mesh_file.empty() && scene.surface.mesh_file.front() != '/' &&
             !base_dir.empty())
             scene.surface.mesh_file = base_dir + "/" + scene.surface.mesh_file;

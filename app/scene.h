@@ -33,7 +33,7 @@ struct SurfaceOptions {
     bool open = false;
 };
 
-/// Motion in the normal direction (paper §4.1, VALIDATION.md A1).
+/// Motion in the normal direction (paper §4.1, docs/validation.md A1).
 struct NormalSpeedOptions {
     /// "face_offsetting" (Jiao's entropy-satisfying scheme) or "vertex_normals" (area-weighted
     /// vertex normals; the paper's non-converging comparison).
@@ -46,7 +46,7 @@ struct NormalSpeedOptions {
     tracker::InversionLimitOptions inversion;        ///< step limit of both methods
 };
 
-/// An exact solution to measure the surface against at every frame (VALIDATION.md A1, A2).
+/// An exact solution to measure the surface against at every frame (docs/validation.md A1, A2).
 struct ExactSolutionOptions {
     /// "none", "two_sphere_normal_flow" (A1: two balls of `radius` around `center0`/`center1`
     /// under /flow/normal_speed with speed > 0; the exact entropy solution of
@@ -111,7 +111,7 @@ struct TimeOptions {
     bool land_on_frames = true;
 };
 
-/// What is written every frame.
+/// What is written every frame (README "Output"; the run's meniscus.json describes it).
 struct OutputOptions {
     bool ply = true;                 ///< surface_NNNN.ply (binary little-endian)
     bool ply_velocity = true;        ///< per-vertex velocity (vx, vy, vz) in the PLY
@@ -119,6 +119,13 @@ struct OutputOptions {
     bool vdb = true;                 ///< fields_NNNN.vdb with `surface` and `density`
     double voxel_size = 0.0;         ///< VDB voxel size (m); 0 = half the surface edge length
     double half_width_voxels = 3.0;  ///< narrow-band half width of `surface` (voxels)
+    double density_ramp_voxels = 2.0;  ///< width of `density`'s step across the surface (voxels)
+    bool vdb_velocity = true;          ///< fluid scenes: grid `vel` in the VDB
+    bool vdb_pressure = true;          ///< fluid scenes: grid `pressure` in the VDB
+    /// Unit of every length written (PLY and OBJ positions, velocities, VDB transforms and
+    /// distances): "m", "cm" or "mm". Millimetres by default: Blender's Cycles renders the
+    /// shipped fluid scenes' ~0.1 mm voxels only when they are not ~1e-4 units small.
+    std::string length_unit = "mm";
 };
 
 /// A whole scene.

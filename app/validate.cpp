@@ -1,4 +1,4 @@
-/// `meniscus validate`: the geometric-flow validation cases of VALIDATION.md part A, each a set
+/// `meniscus validate`: geometric-flow validation cases of docs/validation.md part A, each a set
 /// of tracked runs (app/validate_run.h) measured against its exact or reference solution, and
 /// the driver that runs the selected cases of parts A and B and writes the report.
 
@@ -653,7 +653,7 @@ int run_validation(const ValidateOptions& options) {
 
     std::ostringstream md;
     md << "# Meniscus validation report (" << (options.full ? "full" : "quick") << ")\n\n"
-       << "Cases of VALIDATION.md part A (the paper's §4), run by `meniscus validate"
+       << "Cases of docs/validation.md part A (the paper's §4), run by `meniscus validate"
        << (options.full ? " --full" : " --quick")
        << "`. Every run uses the collision-safe SurfaceTracker unless marked otherwise, and "
           "the exact static self-intersection test runs after every step (`max intersecting "

@@ -1,7 +1,8 @@
 #pragma once
 /// \file `meniscus validate`: runs the paper's geometric-flow validation cases
-/// (part A: A1 normal flow, A2 mean curvature, A3 Enright, A4 curl
-/// noise, A5 per-phase cost; and A6, Zalesak's notched sphere turned once, app/validate_zalesak.h) through the collision-safe SurfaceTracker and writes, into one
+/// (docs/validation.md part A: A1 normal flow, A2 mean curvature, A3 Enright, A4 curl
+/// noise, A5 per-phase cost; A6 Zalesak's notched sphere turned once, app/validate_zalesak.h)
+/// through the collision-safe SurfaceTracker and writes, into one
 /// folder, `report.md` (our numbers beside the paper's, observed orders, per-phase seconds per
 /// step), `results.json` (every number and time series) and PNG plots made by
 /// `plot_validation.py` (written beside them; needs /usr/bin/python3 with matplotlib).

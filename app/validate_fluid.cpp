@@ -1,5 +1,5 @@
-/// Part B of `meniscus validate`: two-phase flow with surface tension (docs/validation.md B1–B5; B6–B7 in validate_viscous.cpp); the
-/// plots are in validate_fluid_plots.cpp.
+/// Part B of `meniscus validate`: two-phase flow with surface tension (docs/validation.md B1–B5;
+/// B6–B7 in validate_viscous.cpp); the plots are in validate_fluid_plots.cpp.
 /// B1–B4 drive a coupling::Simulation step by step and measure the mesh after every step
 /// (app/fluid_measures.h); B5 runs the shipped merge and pinch scenes through run_scene() exactly
 /// as `meniscus run` does, with the exact self-intersection test after every step, and reads
@@ -66,7 +66,7 @@ constexpr double LINEAR_AMPLITUDE_FRACTION = 0.1;
 /// passes the rim's curvature reached the wall faces: at R = 3 cells the 1 % perturbation of
 /// B3 shrank and reversed sign instead of growing.)
 constexpr double WALL_OVERLAP_CELLS = 6.0;
-/// B4 (VALIDATION.md): σ = 1, ρ₁ = ρ₂ = 1, λ = 1, amplitude 0.01λ, inviscid.
+/// B4 (docs/validation.md): σ = 1, ρ₁ = ρ₂ = 1, λ = 1, amplitude 0.01λ, inviscid.
 constexpr double WAVE_LAMBDA = 1.0;
 constexpr double WAVE_AMPLITUDE = 0.01;
 constexpr double WAVE_THICKNESS_CELLS = 4.0;
@@ -631,7 +631,7 @@ FluidValidation run_fluid_validation(const FluidValidationOptions& options) {
     md << "# Part B — two-phase flow with surface tension (docs/validation.md B1–B7)\n\n"
        << (options.full ? "Full variants." : "Quick variants: coarse and short (test suite); "
                                              "`meniscus validate --full` runs the resolutions "
-                                             "VALIDATION.md asks for.")
+                                             "docs/validation.md asks for.")
        << " Every run has the exact self-intersection test after every step.\n\n";
     if (wanted("B1"))
         runner.b1(md);

@@ -1,5 +1,5 @@
 #pragma once
-/// \file Part B of `meniscus validate` (two-phase flow with surface
+/// \file Part B of `meniscus validate` (docs/validation.md: two-phase flow with surface
 /// tension): B1 static drop (Laplace jump, spurious currents), B2 oscillating drop (Lamb's
 /// frequency and damping), B3 Rayleigh–Plateau (linear growth rate, pinch-off), B4 capillary
 /// wave (frequency against ω₀² = σk³/(ρ₁+ρ₂)), B5 merge and pinch scenes (component counts,
@@ -20,7 +20,7 @@ bool is_fluid_case(const std::string& id);
 
 /// Options of run_fluid_validation().
 struct FluidValidationOptions {
-    bool full = false;  ///< false: coarse and short variants (test suite); true: VALIDATION.md's
+    bool full = false;  ///< false: coarse, short variants (test suite); true: docs/validation.md's
     bool quiet = false;
     std::vector<std::string> cases;  ///< "B1" … "B5"; empty: all
     std::filesystem::path out_dir;   ///< where plot data and plots go

@@ -1,6 +1,6 @@
 #pragma once
 /// \file Parameters of `meniscus validate` part A: the paper's setups and numbers
-/// (part A, paper §4) and the choices of ours that the paper leaves
+/// (docs/validation.md part A, paper §4) and the choices of ours that the paper leaves
 /// open. Shared by the runs (validate.cpp) and the report (validate_report.cpp).
 
 namespace meniscus::app::flow_validation {
@@ -301,7 +301,7 @@ inline constexpr double A2_REFERENCE_DX_FULL[] = {0.01, 0.005};
 inline constexpr double A2_REFERENCE_TRUSTED_MARGIN_VOXELS = 1.5;
 inline constexpr double A2_AXISYMMETRIC_TRUSTED_MARGIN_VOXELS = 2.0;
 
-/// A3 Enright (VALIDATION.md A3).
+/// A3 Enright (docs/validation.md A3).
 inline constexpr double ENRIGHT_RADIUS = 0.15;
 inline constexpr double ENRIGHT_CENTER = 0.35;
 inline constexpr double ENRIGHT_PERIOD = 3.0;

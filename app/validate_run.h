@@ -73,7 +73,7 @@ struct RunResult {
 /// summary go to stderr unless `quiet`.
 RunResult run_tracked(const RunSpec& spec, bool quiet);
 
-/// TrackerOptions with the paper's α, β and γ (VALIDATION.md part A).
+/// TrackerOptions with the paper's α, β and γ (docs/validation.md part A).
 tracker::TrackerOptions paper_tracker_options();
 
 /// Every number of a run (spec, counts, seconds per step by phase, volume budget, time series).

@@ -1,5 +1,5 @@
-// Per-phase cost of the A1 normal-flow run (VALIDATION.md A1/A5: two spheres of radius 0.2 grow
-// at 0.2 m/s by face offsetting, merge at t = 0.25, reverse at t = 1) for profiling, without
+// Per-phase cost of the A1 normal-flow run (docs/validation.md A1/A5: two spheres of radius 0.2
+// grow at 0.2 m/s by face offsetting, merge at t = 0.25, reverse at t = 1) for profiling, without
 // the validation suite around it. Usage:
 //
 //   profile_a1 [XI=0.02] [STEPS=400] [THREADS=0 (TBB default)]

@@ -1,7 +1,7 @@
 #pragma once
 /// \file An independent level-set solution of motion by mean curvature, the reference of
-/// VALIDATION.md A2 (the paper's Table 4.3 compares the mesh against a high-resolution level-set
-/// run).
+/// docs/validation.md A2 (the paper's Table 4.3 compares the mesh against a high-resolution
+/// level-set run).
 ///
 /// The surface moves with normal velocity V = −(κ₁ + κ₂) (the sum of the principal curvatures,
 /// positive on a sphere, so a sphere follows R(t) = sqrt(R₀² − 4t)). In level-set form, with φ

@@ -6,33 +6,19 @@
 /// origin + (i+½, j+½, k+½)·dx (voxel size dx, transform translated by origin + ½dx), so no
 /// resampling is needed.
 ///
-/// Closest triangles: OpenVDB supplies the band and a closest polygon per voxel, but that index
-/// is approximate (its band dilation hands polygons from voxel to voxel: distances from it were
-/// off by up to 0.9 dx on a meshed sphere). Each band cell therefore starts from OpenVDB's
-/// triangles of itself and its six face neighbours and walks to any triangle sharing a vertex
-/// with the current best while that one is closer; φ is the exact (double precision) distance
-/// to the triangle found.
-///
-/// Sign rule (several drops and bubbles at once): OpenVDB computes an unsigned field only (its
-/// signed mode decides inside by flood fill and ignores orientation). Each band cell takes the
-/// region of the side of its closest triangle it lies on — `labels(ti).outside` if it lies in front
-/// of the triangle (along its normal), `labels(ti).inside` if behind — where "side" is decided by
-/// the angle-weighted pseudo-normal of the closest feature (face, edge or vertex; Bærentzen and
-/// Aanæs 2005), which is exact for closed, consistently oriented, non-self-intersecting meshes.
-/// The cell is liquid iff that region is RasterizeOptions::liquid_region (1 by default, the
-/// tracker's convention: 0 = ambient gas, 1 = liquid). Hence a drop (labels {1, 0}, outward
-/// normals), a bubble in liquid (labels {0, 1} with outward normals, or {1, 0} with inward
-/// normals) and a pool filling the domain are all classified by their labels, not by winding
-/// parity or flood fill from the domain boundary.
+/// Band and signs: signed_band() (mesh_band.h), shared with the VDB writer — exact distances and
+/// closest triangles in the band, the sign of the region each cell centre lies in by the
+/// pseudo-normal side of its closest triangle and that triangle's labels. The cell is liquid iff
+/// that region is RasterizeOptions::liquid_region (1 by default, the tracker's convention:
+/// 0 = ambient gas, 1 = liquid).
 ///
 /// Cells outside the band get the sign of the band cells they are connected to (a breadth-first
 /// fill over face neighbours) and the magnitude of the band half width (they are not distances).
 /// With no band cell in the domain at all, the region of one cell centre is found from its
 /// closest triangle over the whole mesh (or is the ambient region 0 for an empty mesh) and
 /// given to every cell.
-///
-/// This is the only translation unit of the coupling step that instantiates OpenVDB's mesh tools.
 
+#include "coupling/mesh_band.h"
 #include "fluid/array3.h"
 #include "fluid/mac_grid.h"
 #include "tracker/mesh.h"
@@ -77,12 +63,5 @@ struct RasterizeResult {
 /// std::invalid_argument on invalid options.
 RasterizeResult rasterize_mesh(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
                                const RasterizeOptions& options = {});
-
-/// Local closest-triangle search: from live triangle `start_ti`, repeatedly moves to the live
-/// triangle sharing a vertex with the current one that is closest to `x` (m) while it is
-/// strictly closer (at most 64 moves), and returns where it stops — the closest triangle of the
-/// sheet around `start_ti` unless another sheet lies nearer. INVALID_INDEX for an INVALID start.
-int walk_to_closest_triangle(const tracker::SurfaceMesh& mesh, int start_ti,
-                             const Eigen::Vector3d& x);
 
 }  // namespace meniscus::coupling

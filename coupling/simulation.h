@@ -1,5 +1,5 @@
 #pragma once
-/// \file One coupled step of liquid/gas flow with an explicit interface (DESIGN.md coupling):
+/// \file One coupled step of liquid/gas flow with an explicit interface (docs/architecture.md):
 /// (1) Δt from CFL, the capillary limit (with the smaller of Δx and the mesh's mean edge
 /// length) and the time left to the frame; (2) mesh → φ at cell centres and κ at crossed faces;
 /// (3) the fluid step; (4) grid velocity → mesh vertices, plus the sub-grid surface-tension

@@ -250,6 +250,30 @@ TEST_F(CliTest, UnconvergedViscousSolveIsWarnedAbout) {
     EXPECT_NE(o.output.find("/fluid/viscosity_max_iterations"), std::string::npos) << o.output;
 }
 
+TEST_F(CliTest, ASecondRunIntoTheSameFolderReplacesTheFirst) {
+    // Never a mix of two runs: a shorter run into the folder of a longer one removes the
+    // longer run's frames (and a stale temporary), says so, and leaves other files alone.
+    const std::string scene = write("small.json", SMALL_SCENE);
+    const fs::path out = m_dir / "out";
+    ASSERT_EQ(run_meniscus("run " + scene + " --out " + out.string() + " --quiet").exit_code, 0);
+    ASSERT_TRUE(fs::exists(out / "surface_0002.ply"));
+    std::ofstream(out / "notes.txt") << "mine";
+    std::ofstream(out / "fields_0007.vdb.partial") << "stale";
+    const Outcome o = run_meniscus("run " + scene + " --out " + out.string() + " --frames 1");
+    ASSERT_EQ(o.exit_code, 0) << o.output;
+    EXPECT_NE(o.output.find("removed 12 files of an earlier run"), std::string::npos) << o.output;
+    for (const char* gone :
+         {"surface_0002.ply", "surface_0002.obj", "fields_0002.vdb", "fields_0007.vdb.partial"})
+        EXPECT_FALSE(fs::exists(out / gone)) << gone;
+    for (const char* kept : {"surface_0001.ply", "fields_0001.vdb", "notes.txt", "meniscus.json"})
+        EXPECT_TRUE(fs::exists(out / kept)) << kept;
+    std::ifstream stats(out / "stats.jsonl");
+    int lines = 0;
+    for (std::string line; std::getline(stats, line);)
+        ++lines;
+    EXPECT_EQ(lines, 2);
+}
+
 TEST_F(CliTest, FramesOptionOverridesTheSceneKeepingTimePerFrame) {
     const std::string scene = write("small.json", SMALL_SCENE);
     const fs::path out = m_dir / "out";

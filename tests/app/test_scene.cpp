@@ -134,6 +134,31 @@ TEST(Scene, ErrorsNameTheJsonPath) {
     EXPECT_NE(error_of("[1, 2]").find("/: expected an object"), std::string::npos);
 }
 
+TEST(Scene, OutputKeys) {
+    const char* sphere = R"("surface": {"shape": {"type": "sphere"}})";
+    const Scene defaults = parse_scene(std::string("{") + sphere + "}", "test.json", ".");
+    EXPECT_EQ(defaults.output.length_unit, "mm");
+    EXPECT_TRUE(defaults.output.vdb_velocity);
+    EXPECT_TRUE(defaults.output.vdb_pressure);
+    const Scene set = parse_scene(
+        std::string("{") + sphere +
+            R"(, "output": {"length_unit": "cm", "vdb_velocity": false, "vdb_pressure": false,
+                "density_ramp_voxels": 1.5}})",
+        "test.json", ".");
+    EXPECT_EQ(set.output.length_unit, "cm");
+    EXPECT_FALSE(set.output.vdb_velocity);
+    EXPECT_FALSE(set.output.vdb_pressure);
+    EXPECT_DOUBLE_EQ(set.output.density_ramp_voxels, 1.5);
+    EXPECT_NE(error_of(std::string("{") + sphere + R"(, "output": {"length_unit": "in"}})")
+                  .find(R"(/output/length_unit: expected one of "m", "cm", "mm", got "in")"),
+              std::string::npos);
+    EXPECT_NE(error_of(std::string("{") + sphere +
+                       R"(, "output": {"half_width_voxels": 2, "density_ramp_voxels": 5}})")
+                  .find("/output/density_ramp_voxels: expected at most 2 · "
+                        "/output/half_width_voxels"),
+              std::string::npos);
+}
+
 TEST(Scene, GeometricFlowKeys) {
     const Scene s = parse_scene(R"({"surface": {"shape": {"type": "sphere"}},
         "flow": {"type": "normal_speed", "normal_speed": {"method": "vertex_normals",

@@ -190,6 +190,7 @@ std::vector<nlohmann::json> flow_scene_stats(const std::string& name, int frames
 
 TEST(FlowScenes, A1ErrorInStatsIsTheFlowErrorsComputation) {
     Scene scene = load_scene(FLOW_SCENES + "a1_face_offsetting_xi0.04.json");
+    scene.output.length_unit = "m";  // the PLY is compared with the exact solution in metres
     RunOptions options;
     options.out_dir = (fs::temp_directory_path() / "meniscus_a1_exact").string();
     options.frames = 1;  // t = 0.1: 20 steps of Δt = 0.005
@@ -201,7 +202,7 @@ TEST(FlowScenes, A1ErrorInStatsIsTheFlowErrorsComputation) {
     ASSERT_EQ(lines.size(), 2u);
     const double t = lines[1]["time"];
     EXPECT_DOUBLE_EQ(t, 0.1);
-    // The same error from the written surface and VALIDATION.md A1's exact solution.
+    // The same error from the written surface and docs/validation.md A1's exact solution.
     const tracker::SurfaceMesh mesh = tracker::to_surface_mesh(
         tracker::read_mesh_file((fs::path(options.out_dir) / "surface_0001.ply").string()), "ply");
     tracker::TwoSphereNormalFlow flow;  // defaults: A1's spheres and speed
@@ -222,6 +223,7 @@ TEST(FlowScenes, A1ErrorInStatsIsTheFlowErrorsComputation) {
 TEST(FlowScenes, SphereUnderMeanCurvatureRecordsTheExactRadius) {
     Scene scene = load_scene(FLOW_SCENES + "a2_sphere_xi0.04.json");
     scene.tracker.verify_intersection_free = false;
+    scene.output.length_unit = "m";  // the PLY is compared with the exact sphere in metres
     RunOptions options;
     options.out_dir = (fs::temp_directory_path() / "meniscus_a2_exact").string();
     const fs::path last_frame = fs::path(options.out_dir) / "surface_0002.ply";
@@ -264,6 +266,7 @@ tracker::SurfaceError shrunk_sphere_error(double t_end, bool fitted_smoothing,
     scene.tracker.remesh.collapse_on_fitted_surface = fitted_collapses;
     scene.time.end = t_end;
     scene.time.frames = 1;
+    scene.output.length_unit = "m";  // the PLY is compared with the exact sphere in metres
     RunOptions options;
     options.out_dir = (fs::temp_directory_path() / "meniscus_a2_shrunk").string();
     options.quiet = true;
@@ -300,6 +303,7 @@ TEST(FlowScenes, ShrinkingSphereStaysOnItsRadiusWithFittedSmoothingAndCollapses)
 
 TEST(FlowScenes, OpenSheetKeepsItsBoundaryUnderCurlNoise) {
     Scene scene = load_scene(FLOW_SCENES + "a4_curl_noise_open_xi0.04.json");
+    scene.output.length_unit = "m";  // positions below are compared in metres
     RunOptions options;
     options.out_dir = (fs::temp_directory_path() / "meniscus_open_sheet").string();
     options.frames = 5;  // t = 0.5: 10 RK4 steps

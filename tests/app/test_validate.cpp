@@ -1,5 +1,5 @@
 /// `meniscus validate --quick` in the test suite: runs the coarse validation cases into a
-/// temporary folder and checks the quick targets of VALIDATION.md part A against results.json
+/// temporary folder and checks the quick targets of docs/validation.md part A against results.json
 /// and report.md.
 
 #include "app/validate.h"
@@ -87,11 +87,11 @@ constexpr double ENRIGHT_QUICK_VOLUME_PERCENT = 0.5;
 /// Enright quick: the surface returns near the initial sphere (L∞ distance, m; ξ = 0.02).
 constexpr double ENRIGHT_QUICK_RETURN_LINF = 0.01;
 
-/// Part B quick variants (coarse: the targets of VALIDATION.md are for the --full resolutions).
+/// Part B quick variants (coarse: docs/validation.md targets the --full resolutions).
 /// Measured: Δp −0.003 % at 10 and 16 cells per diameter; Lamb frequency −5.8 % at 12 cells
 /// per diameter; Rayleigh–Plateau growth rate −6.4 % at R = 3 cells; capillary-wave frequency
 /// −4.3 % at 16 cells per wavelength (the errors shrink with resolution: `validate --full`).
-constexpr double B1_JUMP_RELATIVE = 0.02;              ///< VALIDATION.md B1 (≥ 16 cells per D)
+constexpr double B1_JUMP_RELATIVE = 0.02;              ///< docs/validation.md B1 (≥ 16 cells per D)
 constexpr double B1_SPURIOUS_CAPILLARY_NUMBER = 0.05;  ///< max|u| sqrt(ρD/σ); measured 6e-3
 constexpr double B2_QUICK_FREQUENCY_RELATIVE = 0.08;
 constexpr double B3_QUICK_RATE_RELATIVE = 0.10;

@@ -231,7 +231,7 @@ double merged_drop_roughness(int cells_per_diameter, double duration, double sub
 }
 
 TEST(Simulation, StaticDropSpuriousCurrentsWithRawCurvatureStayBounded) {
-    // VALIDATION.md B1 at 16 cells per diameter with the raw cotangent curvature (no smoothing)
+    // docs/validation.md B1, 16 cells per diameter, raw cotangent curvature (no smoothing)
     // for 10 ms (77 steps). Exact curvature (2/R on every crossed face) keeps max|u| at the
     // pressure solver's tolerance, ~3e-7 in these units: the ghost-fluid jump is balanced, so
     // every spurious current comes from the curvature. Regression: without the sub-grid damping

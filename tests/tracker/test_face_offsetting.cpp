@@ -71,7 +71,7 @@ TEST(FaceOffsetting, AngleWeightsAlsoOffsetTheSphere) {
 }
 
 TEST(FaceOffsetting, FirstStepOfTwoSphereTestAgreesWithExactSolution) {
-    const TwoSphereNormalFlow flow;  // VALIDATION.md A1
+    const TwoSphereNormalFlow flow;  // docs/validation.md A1
     const double dt = 0.005;
     for (double edge : {0.04, 0.02}) {
         ImplicitMeshOptions mesh_options;

@@ -1,4 +1,4 @@
-// Exact solutions and error measures of the geometric flows (VALIDATION.md A1).
+// Exact solutions and error measures of the geometric flows (docs/validation.md A1).
 #include "tests/tracker/flow_test_meshes.h"
 
 #include "tracker/flows/flow_errors.h"

@@ -1,7 +1,7 @@
 /// Geometric accuracy of the remeshing operations (issue #5): null-space smoothing and edge
 /// collapse keep the enclosed volume of a sphere, and flips do not cut across folds unless the
 /// quad is far from Delaunay. Volume lost by remeshing on convex surfaces was the main error of
-/// the Enright test (VALIDATION.md A3): flips −1.1 %, collapses −0.25 % over one period at
+/// the Enright test (docs/validation.md A3): flips −1.1 %, collapses −0.25 % over one period at
 /// ξ = 0.02.
 
 #include "remesh_test_meshes.h"

@@ -1,7 +1,7 @@
 #pragma once
 /// \file A level-set solution of motion by mean curvature for surfaces of revolution, solved on
-/// a 2-D meridian grid: an accurate, independent reference for VALIDATION.md A2 (the dumbbell of
-/// the paper's Table 4.3), much finer than a 3-D level set can afford.
+/// a 2-D meridian grid: an accurate, independent reference for docs/validation.md A2 (the dumbbell
+/// of the paper's Table 4.3), much finer than a 3-D level set can afford.
 ///
 /// The surface moves with normal velocity V = −(κ₁ + κ₂) (sum of the principal curvatures,
 /// positive on a sphere, so a sphere follows R(t) = sqrt(R₀² − 4t) and a cylinder

@@ -1,5 +1,5 @@
 #pragma once
-/// \file Exact solutions and error measures for the geometric flows (VALIDATION.md part A).
+/// \file Exact solutions and error measures for the geometric flows (docs/validation.md part A).
 ///
 /// Error of a mesh against an exact surface given by its signed distance φ (negative inside):
 ///
@@ -64,7 +64,7 @@ SurfaceError surface_error(const SurfaceMesh& mesh,
 /// sphere i lies on the patch, else the distance to the ring where the spheres meet.
 double two_ball_union_signed_distance(const Vec3& x, const Vec3& c0, const Vec3& c1, double radius);
 
-/// VALIDATION.md A1 (paper §4.1): two spheres moving in the normal direction with speed +s
+/// docs/validation.md A1 (paper §4.1): two spheres moving in the normal direction with speed +s
 /// until `reversal_time` T, then −s. The exact (entropy) solution: for t ≤ T the union U(t) of
 /// the two balls of radius r₀ + s t; for t ≥ T the erosion {x : dist(x, complement of U(T)) >
 /// s (t − T)} — the neck formed by the merge stays merged. Its signed distance is
@@ -79,7 +79,7 @@ struct TwoSphereNormalFlow {
     double reversal_time = 1.0;     ///< T (s, ≥ 0)
     void validate() const;          ///< throws std::invalid_argument naming the field
 
-    /// Normal speed at time t (m/s): +speed for t < T, −speed for t ≥ T (VALIDATION.md A1).
+    /// Normal speed at time t (m/s): +speed for t < T, −speed for t ≥ T (docs/validation.md A1).
     double normal_speed(double t) const;
     /// Signed distance (m, negative inside) to the exact surface at time t ≥ 0, valid until the
     /// eroded set vanishes (t ≤ T + (r₀ + sT)/s). Throws std::invalid_argument outside that.

@@ -4,7 +4,7 @@
 ///
 /// This is the "first instinct" scheme the paper compares face offsetting against. Where
 /// characteristics merge (concave creases under outward motion, convex ones under inward
-/// motion) it does not produce the entropy solution, and on the two-sphere test (VALIDATION.md
+/// motion) it does not produce the entropy solution, and on the two-sphere test (docs/validation.md
 /// A1) its error does not shrink under refinement. Kept for that comparison only.
 
 #include "tracker/mesh.h"

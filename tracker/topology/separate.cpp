@@ -1,5 +1,6 @@
 #include "tracker/topology/separate.h"
 
+#include "common/assert.h"
 #include "tracker/remesh/element_hash.h"
 #include "tracker/remesh/local_safety.h"
 
@@ -116,6 +117,16 @@ std::vector<std::pair<int, int>> wedge_pairs(const SurfaceMesh& mesh, int ei) {
     return pairs;
 }
 
+/// The fans of vi (vertex_fans()) when it is a live, interior, singular vertex; empty otherwise.
+std::vector<std::vector<int>> singular_vertex_fans(const SurfaceMesh& mesh, int vi) {
+    if (!mesh.vertex_alive(vi) || mesh.is_boundary_vertex(vi))
+        return {};
+    std::vector<std::vector<int>> fans = vertex_fans(mesh, vi);
+    if (fans.size() < 2)
+        fans.clear();
+    return fans;
+}
+
 Vec3 fan_centroid(const SurfaceMesh& mesh, const std::vector<int>& fan, int vi) {
     Vec3 sum = Vec3::Zero();
     int count = 0;
@@ -181,10 +192,8 @@ SeparationReport separate(SurfaceMesh& mesh, const SeparationOptions& options,
     std::unique_ptr<ElementHash> hash;
     const int vertex_count = mesh.num_vertices();
     for (int vi = 0; vi < vertex_count; ++vi) {
-        if (!mesh.vertex_alive(vi) || mesh.is_boundary_vertex(vi))
-            continue;
-        const std::vector<std::vector<int>> fans = vertex_fans(mesh, vi);
-        if (fans.size() < 2)
+        const std::vector<std::vector<int>> fans = singular_vertex_fans(mesh, vi);
+        if (fans.empty())
             continue;
         if (collision_safety && !hash)
             hash = std::make_unique<ElementHash>(mesh, xi);
@@ -245,6 +254,36 @@ SeparationReport separate(SurfaceMesh& mesh, const SeparationOptions& options,
     }
     report.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+}
+
+EdgeManifoldReport make_edge_manifold(SurfaceMesh& mesh) {
+    EdgeManifoldReport report;
+    std::vector<int> nonmanifold;
+    for (int ei = 0; ei < mesh.num_edges(); ++ei)
+        if (mesh.edge_alive(ei) && mesh.is_nonmanifold_edge(ei))
+            nonmanifold.push_back(ei);
+    report.nonmanifold_edges = static_cast<int>(nonmanifold.size());
+    // 1. Midpoints of the non-manifold edges. Splitting one replaces its triangles by halves
+    //    that keep every other edge of theirs, so the others stay alive and non-manifold.
+    for (int ei : nonmanifold) {
+        MENISCUS_ASSERT(mesh.edge_alive(ei) && mesh.is_nonmanifold_edge(ei),
+                        "a non-manifold edge vanished while splitting another");
+        const Edge e = mesh.edge(ei);
+        const int m = mesh.split_edge(ei, 0.5 * (mesh.position(e[0]) + mesh.position(e[1])), 0.5);
+        report.added.push_back({m, e[0], e[1], 0.5});
+    }
+    // 2. One copy per fan of every singular vertex.
+    const int vertex_count = mesh.num_vertices();
+    for (int vi = 0; vi < vertex_count; ++vi) {
+        const std::vector<std::vector<int>> fans = singular_vertex_fans(mesh, vi);
+        if (fans.empty())
+            continue;
+        for (size_t k = 1; k < fans.size(); ++k)
+            report.added.push_back(
+                {mesh.duplicate_vertex(vi, fans[k], mesh.position(vi)), vi, vi, 0.0});
+        ++report.vertices_split;
+    }
     return report;
 }
 

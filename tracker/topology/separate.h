@@ -10,6 +10,7 @@
 #include "tracker/mesh.h"
 #include "tracker/remesh_options.h"
 
+#include <utility>
 #include <vector>
 
 namespace meniscus::tracker {
@@ -36,5 +37,40 @@ std::vector<std::vector<int>> vertex_fans(const SurfaceMesh& mesh, int vi);
 /// retried with halved nudges and refused when none is safe. `xi` sizes the broad phase.
 SeparationReport separate(SurfaceMesh& mesh, const SeparationOptions& options,
                           bool collision_safety, double xi);
+
+/// A vertex make_edge_manifold() added: at parameter `s` from `from0` towards `from1` (a copy of
+/// a vertex has from0 = from1 = the original and s = 0).
+struct AddedVertex {
+    int vi = INVALID_INDEX;
+    int from0 = INVALID_INDEX;
+    int from1 = INVALID_INDEX;
+    double s = 0.0;
+};
+
+/// What make_edge_manifold() did.
+struct EdgeManifoldReport {
+    int nonmanifold_edges = 0;       ///< live edges with more than two triangles, before
+    int vertices_split = 0;          ///< singular vertices split into one copy per fan
+    std::vector<AddedVertex> added;  ///< in creation order (new vertices are appended)
+};
+
+/// For files that must be edge-manifold (renderers, booleans, printers): makes every edge of a
+/// closed, consistently oriented mesh have exactly two triangles, one in each direction, and
+/// every vertex a single fan, without moving the surface.
+///
+/// 1. Every non-manifold edge (two sheets brought together along it mid-merge or mid-pinch) is
+///    split at its midpoint. Its endpoints may each have a single fan — the sheets meet again
+///    around them (a pinched tube) — but the midpoint touches the sheets only through the split
+///    edge, so its triangles form one fan per sheet (vertex_fans()' wedge pairs).
+/// 2. Every singular vertex — one whose triangles form several fans (vertex_fans()), such as
+///    those midpoints, or a vertex where two sheets touch — is split into one copy per fan at
+///    the same position (the paper's separation, §3.6, without its nudge).
+///
+/// The midpoints lie on their edges, so the split triangles are coplanar halves of the old ones,
+/// and copies do not move: the enclosed volume changes by round-off only. Vertices on an open
+/// boundary are left alone. (The tracker's own separation, separate(), nudges copies apart and
+/// refuses a split that would intersect; this one never moves anything, so it always succeeds
+/// where the windings alternate around each edge.)
+EdgeManifoldReport make_edge_manifold(SurfaceMesh& mesh);
 
 }  // namespace meniscus::tracker
