@@ -3,7 +3,9 @@
 #include "app/json_fields.h"
 #include "app/scene_shapes.h"
 
+#include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -24,6 +26,12 @@ const std::vector<std::pair<std::string, tracker::MeanCurvatureIntegrator>>
 const std::vector<std::pair<std::string, tracker::CurvatureOperator>> CURVATURE_OPERATORS = {
     {"cotangent", tracker::CurvatureOperator::cotangent},
     {"quartic_fit", tracker::CurvatureOperator::quartic_fit}};
+/// A scene file larger than this is refused before it is read (scenes are small; meshes go in
+/// mesh_file).
+constexpr std::uintmax_t MAX_SCENE_FILE_BYTES = 16u << 20;
+/// Deepest nesting of JSON arrays/objects accepted (the deepest shipped scene nests 6).
+constexpr int MAX_JSON_DEPTH = 64;
+
 const std::vector<std::string> EXACT_TYPES = {"none", "two_sphere_normal_flow",
                                               "sphere_mean_curvature"};
 
@@ -506,12 +514,47 @@ void validate_flow(const Scene& scene, const nlohmann::json& j) {
 }
 
 std::string read_file(const std::string& path) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (std::filesystem::is_directory(status))
+        throw SceneError(path + ": is a directory, not a scene file");
     std::ifstream in(path);
     if (!in)
         throw SceneError(path + ": cannot open the scene file");
+    const auto size = std::filesystem::is_regular_file(status)
+                          ? std::filesystem::file_size(path, ec)
+                          : std::uintmax_t{0};
+    if (!ec && size > MAX_SCENE_FILE_BYTES)
+        throw SceneError(path + ": " + std::to_string(size) +
+                         " bytes is too large for a scene file (at most " +
+                         std::to_string(MAX_SCENE_FILE_BYTES) + "; meshes go in mesh_file)");
     std::ostringstream s;
     s << in.rdbuf();
     return s.str();
+}
+
+/// Deepest nesting of arrays and objects in JSON text (brackets outside strings). Checked
+/// before parsing, so that no recursion over the document can run out of stack.
+int json_nesting_depth(const std::string& text) {
+    int depth = 0, deepest = 0;
+    bool in_string = false, escaped = false;
+    for (const char c : text) {
+        if (in_string) {
+            if (escaped)
+                escaped = false;
+            else if (c == '\\')
+                escaped = true;
+            else if (c == '"')
+                in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            deepest = std::max(deepest, ++depth);
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+    return deepest;
 }
 
 }  // namespace
@@ -519,10 +562,15 @@ std::string read_file(const std::string& path) {
 Scene parse_scene(const std::string& json_text, const std::string& source,
                   const std::string& base_dir) {
     try {
+        const int depth = json_nesting_depth(json_text);
+        if (depth > MAX_JSON_DEPTH)
+            throw SceneError("invalid scene: arrays and objects nested " + std::to_string(depth) +
+                             " deep (at most " + std::to_string(MAX_JSON_DEPTH) + ")");
         nlohmann::json j;
         try {
             j = nlohmann::json::parse(json_text);
-        } catch (const nlohmann::json::parse_error& e) {
+        } catch (const nlohmann::json::exception& e) {
+            // Syntax errors, and numbers beyond the range of a double (1e400: out_of_range).
             throw SceneError(std::string("invalid JSON: ") + e.what());
         }
         Scene scene;

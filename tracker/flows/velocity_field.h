@@ -2,6 +2,7 @@
 /// \file Analytic velocity fields for the paper's external-flow tests (§4.3) and vertex
 /// advection by classical RK4 through them.
 
+#include "common/cancellation.h"
 #include "tracker/mesh.h"
 
 #include <vector>
@@ -31,8 +32,10 @@ private:
 };
 
 /// Displacements over [t, t + dt] of each live vertex of `mesh` by classical fourth-order
-/// Runge–Kutta through `field` (dead slots get zero). The mesh is not modified.
+/// Runge–Kutta through `field` (dead slots get zero). The mesh is not modified. Throws
+/// meniscus::Cancelled when `cancel` is requested (checked per vertex: a field of many modes
+/// makes each evaluation long).
 std::vector<Vec3> rk4_displacements(const SurfaceMesh& mesh, const VelocityField& field, double t,
-                                    double dt);
+                                    double dt, const CancellationToken& cancel = {});
 
 }  // namespace meniscus::tracker
