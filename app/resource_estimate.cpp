@@ -39,6 +39,13 @@ constexpr double VDB_BYTES_PER_VOXEL = 50.0;
 constexpr double VDB_BYTES_PER_FLUID_CELL = 40.0;
 /// Triangles of a mesh with mean edge length ξ per m² of surface: 1 / (√3/4 ξ²).
 constexpr double EQUILATERAL_AREA_FACTOR = 0.4330127018922193;
+/// Motion per step beyond this many edge lengths makes collision handling's candidate sets
+/// explode (A1's two spheres at ξ = 0.01: 2 steps of 1 ξ take 1 s, of 10 ξ 37 s, of 30 ξ 245 s;
+/// the shipped scenes move at most 2.5 ξ per step, Enright).
+constexpr double MAX_STEP_MOTION_EDGES = 5.0;
+/// Peak over mean speed of the flows without a closed-form maximum.
+constexpr double ENRIGHT_MAX_SPEED = 2.45;  ///< |u| ≤ sqrt(2² + 1 + 1) on the unit cube
+constexpr double CURL_NOISE_PEAK_OVER_RMS = 4.0;
 /// Doubles resolve a length ℓ at coordinates up to about ℓ · 1e12 with room for the exact
 /// predicates and differences of nearby positions.
 constexpr double MAX_COORDINATE_TO_LENGTH = 1e12;
@@ -120,6 +127,10 @@ ResourceEstimate estimate_resources(const Scene& scene, const SurfaceSize& surfa
     e.initial_triangles = surface.triangles > 0.0
                               ? surface.triangles
                               : surface.area / (EQUILATERAL_AREA_FACTOR * xi * xi);
+    e.edge_length = scene.tracker.characteristic_length > 0.0 ? scene.tracker.characteristic_length
+                    : surface.from_mesh_file && surface.triangles > 0.0
+                        ? std::sqrt(surface.area / (EQUILATERAL_AREA_FACTOR * surface.triangles))
+                        : xi;
     const std::string surface_keys =
         surface.from_mesh_file ? "/surface/mesh_file" : "/surface/shape, " + edge_length_origin(scene);
     e.memory.push_back({"surface mesh of about " + format_number(e.initial_triangles) +
@@ -187,6 +198,10 @@ ResourceEstimate estimate_resources(const Scene& scene, const SurfaceSize& surfa
                                  (scene.fluid.time_step.cfl_number * dx);
         const double fixed_steps = frame_dt / dt;
         e.steps_per_frame = fixed_steps + cfl_steps;
+        e.step_motion = scene.fluid.time_step.cfl_number * dx;
+        e.step_motion_keys = "/fluid/cfl_number " + format_number(scene.fluid.time_step.cfl_number) +
+                             " cells of " + format_number(dx) + " m (/domain)";
+        e.step_motion_fix = "lower /fluid/cfl_number";
         if (!(cfl_steps <= fixed_steps))
             e.step_limit = "the CFL limit with /initial_velocity (up to " + format_number(speed) +
                            " m/s) and /fluid/gravity (" + format_number(gravity) +
@@ -219,6 +234,25 @@ ResourceEstimate estimate_resources(const Scene& scene, const SurfaceSize& surfa
             }
         }
         e.steps_per_frame = frame_dt / dt;
+        double speed = 0.0;
+        std::string speed_keys;
+        if (scene.flow.type == "normal_speed") {
+            speed = std::abs(scene.flow.normal_speed.speed);
+            speed_keys = "/flow/normal_speed/speed";
+        } else if (scene.flow.type == "enright") {
+            speed = ENRIGHT_MAX_SPEED;
+            speed_keys = "the Enright field's peak speed";
+        } else if (scene.flow.type == "curl_noise") {
+            speed = CURL_NOISE_PEAK_OVER_RMS * scene.flow.curl_noise.rms_speed;
+            speed_keys = "/flow/curl_noise/rms_speed (peaks about 4x)";
+        }
+        // The offered step: an expanding surface is not shortened by the inversion limit.
+        const double offered = scene.time.dt;
+        e.step_motion = speed * offered;
+        e.step_motion_keys = speed_keys + " " + format_number(speed) + " m/s over /time/dt " +
+                             format_number(offered) + " s";
+        e.step_motion_fix = "shorten /time/dt to at most " +
+                            format_number(MAX_STEP_MOTION_EDGES * e.edge_length / speed) + " s";
     }
     return e;
 }
@@ -237,6 +271,16 @@ void check_resources(const Scene& scene, const ResourceEstimate& estimate,
               << (p.while_meshing ? " (while meshing)" : "");
         s << "\n  " << format_bytes(PROGRAM_BYTES) << " for the program itself"
           << "\ncheck those values, or raise the limit with --max-memory GB";
+        throw InputError(s.str());
+    }
+    if (!(estimate.step_motion <= MAX_STEP_MOTION_EDGES * estimate.edge_length)) {
+        std::ostringstream s;
+        s << scene.source_path << ": a time step would move the surface by up to "
+          << format_number(estimate.step_motion) << " m (" << estimate.step_motion_keys << "), "
+          << format_number(estimate.step_motion / estimate.edge_length)
+          << " edge lengths of " << format_number(estimate.edge_length)
+          << " m; collision handling needs steps of at most "
+          << format_number(MAX_STEP_MOTION_EDGES) << " edge lengths: " << estimate.step_motion_fix;
         throw InputError(s.str());
     }
     if (!(estimate.steps_per_frame <= limits.max_steps_per_frame)) {

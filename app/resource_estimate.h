@@ -36,6 +36,12 @@ struct ResourceEstimate {
     double steps_per_frame = 0.0;
     /// What sets the step (e.g. "the capillary limit 1.2e-5 s (/fluid/phases)").
     std::string step_limit;
+    double edge_length = 0.0;  ///< ξ of the initial surface (m)
+    /// Largest motion of a vertex in one step (m) and what sets it: collision handling costs
+    /// grow steeply with the motion per step in edge lengths.
+    double step_motion = 0.0;
+    std::string step_motion_keys;
+    std::string step_motion_fix;  ///< what to change to make it shorter
     /// The program's own memory plus the larger of the parts needed while meshing and those
     /// needed while stepping.
     double memory_bytes() const;

@@ -306,10 +306,12 @@ SurfaceMesh mesh_implicit_shape(const ImplicitShape& shape, const ImplicitMeshOp
     MarchingTetrahedra marching(shape, GRID_SPACING_FRACTION * options.edge_length,
                                 options.cancel);
     SurfaceMesh mesh = marching.build();
-    if (mesh.count_live_triangles() == 0)
-        throw std::runtime_error("the shape has no surface at edge_length " +
-                                 std::to_string(options.edge_length) +
-                                 " (is it smaller than one edge?)");
+    if (mesh.count_live_triangles() == 0) {
+        std::ostringstream s;
+        s << "the shape has no surface at edge_length " << options.edge_length
+          << " m (is it smaller than one edge?)";
+        throw std::runtime_error(s.str());
+    }
     IsotropicRemeshOptions remesh;
     remesh.target_edge_length = options.edge_length;
     remesh.iterations = options.remesh_iterations;

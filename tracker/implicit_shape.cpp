@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -16,9 +17,11 @@ namespace {
 constexpr double GRADIENT_STEP_FRACTION = 1e-7;
 
 void require_positive(double v, const char* what) {
-    if (!(v > 0.0) || !std::isfinite(v))
-        throw std::invalid_argument(std::string(what) + " must be a finite number > 0, got " +
-                                    std::to_string(v));
+    if (!(v > 0.0) || !std::isfinite(v)) {
+        std::ostringstream s;
+        s << what << " must be a finite number > 0, got " << v;
+        throw std::invalid_argument(s.str());
+    }
 }
 
 Vector3d normalized_axis(const Vector3d& axis) {

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -33,11 +34,15 @@ using meniscus::test::ChildResult;
 constexpr int SHARDS = 8;
 constexpr int CASES_PER_SHARD = 40;
 constexpr std::uint64_t SEED = 20240537;
-/// Per case: wall time and address space (the run is told --max-memory 1 GB).
-constexpr double CASE_WALL_SECONDS = 90.0;
-constexpr unsigned long long CASE_ADDRESS_SPACE = 6ull << 30;
-/// Beyond CASE_WALL_SECONDS a case is a hang; above this it is reported as slow.
-constexpr double SLOW_CASE_SECONDS = 20.0;
+/// Per case: the memory the run may plan for (--max-memory, GB: the finest shipped scenes are
+/// refused, which keeps cases short), the address space it may take (RLIMIT_AS: the plan,
+/// the libraries and thread stacks, with room for the estimate's error) and the wall time
+/// after which it counts as hung (generous: the suite runs tests in parallel on two cores).
+const char* CASE_MAX_MEMORY_GB = "0.3";
+constexpr unsigned long long CASE_ADDRESS_SPACE = 3ull << 30;
+constexpr double CASE_WALL_SECONDS = 60.0;
+/// Sanitizer builds run several times slower.
+constexpr double SANITIZER_SLOWDOWN = 5.0;
 
 std::string read_text(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
@@ -160,20 +165,26 @@ public:
     }
 
     Case next() {
-        const auto& [name, base] = m_scenes[pick(m_scenes.size())];
-        Case c;
-        json scene = base;
-        c.description = name;
         const int kind = static_cast<int>(pick(100));
-        if (kind < 30) {
+        // Mesh files go into geometric-flow scenes (the fluid scenes' boxes are millimetres).
+        std::pair<std::string, json> chosen = m_scenes[pick(m_scenes.size())];
+        while (kind >= 50 && kind < 70 && chosen.second.contains("flow") &&
+               chosen.second["flow"].value("type", "") == "fluid")
+            chosen = m_scenes[pick(m_scenes.size())];
+        Case c;
+        json scene = chosen.second;
+        c.description = chosen.first;
+        if (kind < 40) {
             const int n = 1 + static_cast<int>(pick(3));
             for (int i = 0; i < n; ++i)
-                mutate_value(scene, c.description);
-        } else if (kind < 38) {
+                scale_number(scene, c.description);
+        } else if (kind < 45) {
+            mutate_value(scene, c.description);
+        } else if (kind < 48) {
             mutate_structure(scene, c.description);
-        } else if (kind < 44) {
+        } else if (kind < 50) {
             deep_nesting(scene, c.description);
-        } else if (kind < 68) {
+        } else if (kind < 70) {
             mesh_case(scene, c);
         } else if (kind < 76) {
             std::string text = scene.dump(1);
@@ -206,6 +217,28 @@ private:
         return values[pick(values.size())];
     }
 
+    /// A number of the scene scaled (mildly or wildly), negated or zeroed: values of the right
+    /// type that reach the solvers.
+    void scale_number(json& scene, std::string& description) {
+        std::vector<std::string> paths;
+        collect_paths(scene, "", paths);
+        std::vector<std::string> numbers;
+        for (const std::string& p : paths)
+            if (scene.at(json::json_pointer(p)).is_number())
+                numbers.push_back(p);
+        if (numbers.empty())
+            return mutate_value(scene, description);
+        const std::string p = numbers[pick(numbers.size())];
+        const json& old = scene.at(json::json_pointer(p));
+        static const double factors[] = {1e-9, 1e-4, 0.01, 0.1, 0.3, 0.5, 0.9, 1.1, 2.0,
+                                         3.0,  10.0, 100.0, 1e4, 1e9, -1.0, 0.0};
+        json v = old.get<double>() * factors[pick(16)];
+        if (old.is_number_integer())
+            v = static_cast<long long>(std::clamp(v.get<double>(), -9e18, 9e18));
+        description += "; " + p + " = " + v.dump();
+        scene[json::json_pointer(p)] = v;
+    }
+
     void mutate_value(json& scene, std::string& description) {
         std::vector<std::string> paths;
         collect_paths(scene, "", paths);
@@ -221,8 +254,11 @@ private:
         // Scale an existing number instead, half of the time: plausible-looking extremes.
         const json& old = scene.at(json::json_pointer(p));
         if (old.is_number() && pick(2) == 0) {
-            static const double factors[] = {1e-12, 1e-6, 1e-3, 1e3, 1e6, 1e12, -1.0, 0.0};
-            v = old.get<double>() * factors[pick(8)];
+            static const double factors[] = {1e-12, 1e-6, 1e-3, 0.1, 0.5, 2.0,
+                                             10.0,  1e3,  1e6,  1e12, -1.0, 0.0};
+            v = old.get<double>() * factors[pick(12)];
+            if (old.is_number_integer() && std::abs(v.get<double>()) < 9e18)
+                v = static_cast<long long>(v.get<double>());
         }
         description += "; " + p + " = " + v.dump();
         scene[json::json_pointer(p)] = v;
@@ -430,6 +466,8 @@ TEST_P(FuzzRun, BadInputIsRefusedOrRunsNeverCrashesHangsOrFailsInternally) {
     fs::create_directories(dir);
     write_text(dir / "a_file", "not a folder\n");
     Generator generator(SEED + static_cast<std::uint64_t>(shard), dir);
+    // MENISCUS_FUZZ_VERBOSE=1 prints every case and the first line of its output.
+    const bool verbose = std::getenv("MENISCUS_FUZZ_VERBOSE") != nullptr;
     std::map<int, int> outcomes;
     int failures = 0;
     double slowest = 0.0, total = 0.0;
@@ -444,7 +482,7 @@ TEST_P(FuzzRun, BadInputIsRefusedOrRunsNeverCrashesHangsOrFailsInternally) {
         fs::remove_all(out);
         std::vector<std::string> argv = {MENISCUS_BINARY, "run", scene.string(),
                                          "--quiet", "--frames", "1", "--max-steps", "2",
-                                         "--max-memory", "1"};
+                                         "--max-memory", CASE_MAX_MEMORY_GB};
         bool custom_out = false;
         for (const std::string& a : c.arguments) {
             argv.push_back(a);
@@ -456,7 +494,9 @@ TEST_P(FuzzRun, BadInputIsRefusedOrRunsNeverCrashesHangsOrFailsInternally) {
         }
         ChildLimits limits;
         limits.wall_seconds = CASE_WALL_SECONDS;
-        if (!meniscus::test::built_with_address_sanitizer())
+        if (meniscus::test::built_with_address_sanitizer())
+            limits.wall_seconds *= SANITIZER_SLOWDOWN;
+        else
             limits.address_space_bytes = CASE_ADDRESS_SPACE;
         const ChildResult r = meniscus::test::run_child(argv, limits, (dir / "log.txt").string());
         total += r.seconds;
@@ -475,10 +515,11 @@ TEST_P(FuzzRun, BadInputIsRefusedOrRunsNeverCrashesHangsOrFailsInternally) {
                           << " after " << r.seconds << " s\n--- output ---\n"
                           << r.output.substr(0, 2000) << "\n--- scene ---\n"
                           << c.scene_text.substr(0, 3000);
-        } else if (r.seconds > SLOW_CASE_SECONDS) {
-            ADD_FAILURE() << "case " << shard << "." << i << " (" << c.description
-                          << ") took " << r.seconds << " s:\n" << r.output.substr(0, 2000);
         }
+        if (verbose)
+            std::printf("case %d.%d (%s): %s %.1f s: %s\n", shard, i, c.description.c_str(),
+                        r.exited ? ("exit " + std::to_string(r.exit_code)).c_str() : "killed",
+                        r.seconds, r.output.substr(0, r.output.find('\n')).c_str());
     }
     std::printf("fuzz shard %d: %d cases in %.1f s (slowest %.1f s: %s); exit 0: %d, exit 2: %d, "
                 "other: %d\n",
