@@ -295,6 +295,22 @@ void check_resources(const Scene& scene, const ResourceEstimate& estimate,
     }
 }
 
+std::vector<std::string> plausibility_warnings(const Scene& scene, double xi) {
+    std::vector<std::string> warnings;
+    if (scene.flow.type == "curl_noise") {
+        const tracker::CurlNoiseOptions& c = scene.flow.curl_noise;
+        const double finest = c.base_wavelength / std::pow(c.lacunarity, c.octaves - 1);
+        if (finest < xi)
+            warnings.push_back(
+                "/flow/curl_noise: the finest octave's wavelength (" + format_number(finest) +
+                " m: base_wavelength over lacunarity^(octaves - 1)) is shorter than the edge "
+                "length " + format_number(xi) +
+                " m; the mesh cannot follow it, so it acts as noise that keeps remeshing and "
+                "collision handling busy");
+    }
+    return warnings;
+}
+
 void check_scene_scale(const Scene& scene) {
     const auto fail = [&](const std::string& what) { throw InputError(scene.source_path + ": " + what); };
     const double xi = scene.surface.edge_length;

@@ -73,6 +73,10 @@ void check_resources(const Scene& scene, const ResourceEstimate& estimate,
 /// derived cell counts must fit. Throws InputError naming the keys.
 void check_scene_scale(const Scene& scene);
 
+/// Things a scene may mean but that will not do what it seems to (printed as warnings before
+/// the run): curl-noise octaves finer than the edge length `xi` (m) of the initial surface.
+std::vector<std::string> plausibility_warnings(const Scene& scene, double xi);
+
 /// "1.5 GB", "320 MB" (powers of 1000).
 std::string format_bytes(double bytes);
 

@@ -678,6 +678,8 @@ static void run_geometric_scene(const Scene& scene, const RunOptions& options,
         std::fprintf(stderr, "%s: %s\n", scene.name.c_str(), report.c_str());
     if (exact.enabled())
         exact.check_initial(mesh, tracker.characteristic_length());
+    for (const std::string& warning : plausibility_warnings(scene, tracker.characteristic_length()))
+        std::fprintf(stderr, "meniscus: warning: %s\n", warning.c_str());
     const GeometricFlow flow = make_flow(scene.flow, scene.cancel);
 
     FrameWriter writer(scene, options.out_dir);
