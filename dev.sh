@@ -2,6 +2,9 @@
 # Meniscus developer entry point: installs what is missing, builds incrementally, then
 #   ./dev.sh run [SCENE.json] [meniscus run options]   runs a scene (default: the README's), frames in out/
 #   ./dev.sh test                                       runs the whole test suite through ctest
+#   ./dev.sh sanitize                                   builds in build-sanitize/ with Address- and
+#                                                       UndefinedBehaviorSanitizer and runs the fast
+#                                                       tests there (CI runs it after `test`)
 #   ./dev.sh build                                      only sets up and builds
 # Idempotent: with everything installed and built it only checks and runs.
 set -euo pipefail
@@ -9,6 +12,14 @@ cd "$(dirname "$0")"
 
 DEFAULT_SCENE=scenes/drop_merge.json
 BUILD_DIR=${MENISCUS_BUILD_DIR:-build}
+SANITIZE_BUILD_DIR=${MENISCUS_SANITIZE_BUILD_DIR:-build-sanitize}
+# The sanitizer pass leaves out what only repeats the same code for longer: the validation
+# suite, the scene runs and physics checks (each minutes under ASan), and all but two shards of
+# the fuzz test (80 of its cases).
+SANITIZE_EXCLUDE='QuickValidation|SceneRuns|ScenesPhysics|FuzzRun.*/[2-9]$'
+# Any finding ends the program with exit code 86 (tests then fail); LeakSanitizer included.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-exitcode=86:detect_leaks=1:strict_string_checks=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-exitcode=86:print_stacktrace=1}
 PACKAGES=(cmake ninja-build g++ ccache libeigen3-dev libtbb-dev libopenvdb-dev libboost-iostreams-dev
           nlohmann-json3-dev libgtest-dev libbenchmark-dev libgmp-dev python3-matplotlib python3-numpy)
 
@@ -35,9 +46,24 @@ build() {
   cmake --build "$BUILD_DIR" -j "$(nproc)"
 }
 
+# -O1 with line tables: quick to build, readable stack traces; benchmarks left out.
+sanitize_build() {
+  if [ ! -f "$SANITIZE_BUILD_DIR/build.ninja" ]; then
+    cmake -S . -B "$SANITIZE_BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DMENISCUS_SANITIZE=ON \
+      -DMENISCUS_BUILD_BENCH=OFF
+  fi
+  cmake --build "$SANITIZE_BUILD_DIR" -j "$(nproc)"
+}
+
 cmd=${1:-run}
 shift || true
 install_missing
+if [ "$cmd" = sanitize ]; then
+  sanitize_build
+  cd "$SANITIZE_BUILD_DIR"
+  exec ctest --output-on-failure -j "$(nproc)" --timeout 1800 -E "$SANITIZE_EXCLUDE"
+fi
 build
 case "$cmd" in
   run)
@@ -50,5 +76,5 @@ case "$cmd" in
     exec ctest --output-on-failure -j "$(nproc)" --timeout 900
     ;;
   build) ;;
-  *) echo "usage: ./dev.sh [run [SCENE.json] [options] | test | build]" >&2; exit 2 ;;
+  *) echo "usage: ./dev.sh [run [SCENE.json] [options] | test | sanitize | build]" >&2; exit 2 ;;
 esac

@@ -165,10 +165,12 @@ public:
                              r * (Vector3d::Ones() - m_a.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
         return Box3(m_c - ext, m_c + ext);
     }
+    /// The side: mean circumference 2πR times the length of the profile, whose slope
+    /// R ε k sin(ks) has mean square (R ε k)²/2; the caps at most π (R(1 + ε))² each.
     double surface_area(const Box3&) const override {
-        const double r = m_r * (1.0 + m_eps), slope = m_r * m_eps * m_k;
-        return 2.0 * M_PI * r * (2.0 * m_half) * std::sqrt(1.0 + slope * slope) +
-               2.0 * M_PI * r * r;
+        const double slope = m_r * m_eps * m_k, cap = m_r * (1.0 + m_eps);
+        return 2.0 * M_PI * m_r * (2.0 * m_half) * std::sqrt(1.0 + 0.5 * slope * slope) +
+               2.0 * M_PI * cap * cap;
     }
 
 private:

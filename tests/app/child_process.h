@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <chrono>
 #include <csignal>
 #include <fstream>
@@ -33,7 +34,8 @@ struct ChildResult {
 /// Limits applied in the child before exec (0 = none).
 struct ChildLimits {
     double wall_seconds = 120.0;
-    unsigned long long address_space_bytes = 0;  ///< RLIMIT_AS
+    /// RLIMIT_AS; under AddressSanitizer, ASan's hard_rss_limit_mb instead.
+    unsigned long long address_space_bytes = 0;
     unsigned long long file_size_bytes = 0;      ///< RLIMIT_FSIZE (SIGXFSZ ignored: EFBIG)
 };
 
@@ -62,6 +64,24 @@ inline ChildResult run_child(const std::vector<std::string>& argv, const ChildLi
     for (const std::string& a : argv)
         args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
+    // The environment, prepared before fork. Under AddressSanitizer the address-space bound
+    // becomes ASan's own resident-memory bound (RLIMIT_AS cannot hold its shadow memory).
+    std::vector<std::string> environment;
+    for (char** e = environ; *e != nullptr; ++e)
+        if (!built_with_address_sanitizer() || std::string(*e).rfind("ASAN_OPTIONS=", 0) != 0)
+            environment.emplace_back(*e);
+    if (built_with_address_sanitizer() && limits.address_space_bytes > 0) {
+        const char* asan = std::getenv("ASAN_OPTIONS");
+        environment.push_back(std::string("ASAN_OPTIONS=") + (asan ? asan : "") +
+                              (asan && *asan ? ":" : "") + "hard_rss_limit_mb=" +
+                              std::to_string(limits.address_space_bytes >> 20));
+    } else if (const char* asan = std::getenv("ASAN_OPTIONS")) {
+        environment.push_back(std::string("ASAN_OPTIONS=") + asan);
+    }
+    std::vector<char*> envp;
+    for (const std::string& e : environment)
+        envp.push_back(const_cast<char*>(e.c_str()));
+    envp.push_back(nullptr);
     const auto start = std::chrono::steady_clock::now();
     const pid_t pid = fork();
     ChildResult r;
@@ -75,7 +95,7 @@ inline ChildResult run_child(const std::vector<std::string>& argv, const ChildLi
         dup2(fd, STDOUT_FILENO);
         dup2(fd, STDERR_FILENO);
         setpgid(0, 0);  // its own process group: the test's signals reach only it
-        if (limits.address_space_bytes > 0) {
+        if (limits.address_space_bytes > 0 && !built_with_address_sanitizer()) {
             const rlimit as{limits.address_space_bytes, limits.address_space_bytes};
             setrlimit(RLIMIT_AS, &as);
         }
@@ -84,7 +104,7 @@ inline ChildResult run_child(const std::vector<std::string>& argv, const ChildLi
             const rlimit fs{limits.file_size_bytes, limits.file_size_bytes};
             setrlimit(RLIMIT_FSIZE, &fs);
         }
-        execv(args[0], args.data());
+        execve(args[0], args.data(), envp.data());
         _exit(127);
     }
     int status = 0;

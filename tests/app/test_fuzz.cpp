@@ -494,10 +494,9 @@ TEST_P(FuzzRun, BadInputIsRefusedOrRunsNeverCrashesHangsOrFailsInternally) {
         }
         ChildLimits limits;
         limits.wall_seconds = CASE_WALL_SECONDS;
+        limits.address_space_bytes = CASE_ADDRESS_SPACE;
         if (meniscus::test::built_with_address_sanitizer())
             limits.wall_seconds *= SANITIZER_SLOWDOWN;
-        else
-            limits.address_space_bytes = CASE_ADDRESS_SPACE;
         const ChildResult r = meniscus::test::run_child(argv, limits, (dir / "log.txt").string());
         total += r.seconds;
         if (r.seconds > slowest) {
