@@ -33,6 +33,8 @@ constexpr std::uintmax_t MAX_SCENE_FILE_BYTES = 16u << 20;
 /// 72). A step evaluates every mode four times per vertex: 20 000 modes on 4 000 vertices took
 /// 14 s per step, 160 000 modes (16 octaves of 10 000) made two steps on 550 vertices take 46 s.
 constexpr long long MAX_CURL_NOISE_MODES = 4096;
+/// Most /initial_velocity regions (each is evaluated at every velocity face of the grid).
+constexpr size_t MAX_VELOCITY_REGIONS = 64;
 /// Deepest nesting of JSON arrays/objects accepted (the deepest shipped scene nests 6).
 constexpr int MAX_JSON_DEPTH = 64;
 
@@ -445,6 +447,10 @@ std::vector<VelocityRegion> parse_velocity_regions(const nlohmann::json& j) {
     const std::string path = "/initial_velocity";
     if (!j.is_array())
         throw SceneError(path + ": expected an array of {shape, velocity}");
+    if (j.size() > MAX_VELOCITY_REGIONS)
+        throw SceneError(path + ": " + std::to_string(j.size()) + " regions; at most " +
+                         std::to_string(MAX_VELOCITY_REGIONS) +
+                         " (every velocity face is tested against every region)");
     std::vector<VelocityRegion> regions;
     for (size_t i = 0; i < j.size(); ++i) {
         const std::string item = path + "/" + std::to_string(i);

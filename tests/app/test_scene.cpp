@@ -60,6 +60,12 @@ TEST(Scene, InputThatWouldOverflowOrNestWithoutBoundIsRefusedWithItsPath) {
     EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "name": )" + deep + "}")
                   .find("arrays and objects nested 101 deep (at most 64)"),
               std::string::npos);
+    std::string regions;
+    for (int i = 0; i < 65; ++i)
+        regions += std::string(i ? ", " : "") + R"({"shape": {"type": "sphere"}, "velocity": [1, 0, 0]})";
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "initial_velocity": [)" + regions + "]}")
+                  .find("/initial_velocity: 65 regions; at most 64"),
+              std::string::npos);
     // Validation errors name the key the user wrote, not a C++ name.
     EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "tracker": {"topology": {"separation": {"nudge_fraction": 0.6}}}})")
                   .find("/tracker/topology/separation/nudge_fraction: expected a number in (0, 0.5)"),
