@@ -160,7 +160,7 @@ std::string many_spheres(int count) {
 std::vector<BadScene> bad_scenes() {
     return {
         {"number_beyond_double", R"({"surface": {"shape": {"type": "sphere", "radius": 1e400}}})",
-         "scene.json: invalid JSON", {}},
+         "scene.json: /surface/shape/radius: expected a number, got 1e400", {}},
         {"magnitude_1e308", R"({"surface": {"shape": {"type": "sphere", "radius": 1e308}}})",
          "/surface/shape/radius: expected a number > 0, got 1e+308 (magnitudes outside", {}},
         {"tiny_density", fluid_scene(R"(, "fluid": {"phases": {"rho_gas": 1e-300}})"),

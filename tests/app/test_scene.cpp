@@ -35,9 +35,17 @@ TEST(Scene, EveryShippedSceneParses) {
 }
 
 TEST(Scene, InputThatWouldOverflowOrNestWithoutBoundIsRefusedWithItsPath) {
-    // Numbers beyond a double (the JSON library's overflow) name the file.
+    // Numbers beyond a double (the JSON library's overflow, which has no position) name the
+    // file and the JSON path, also inside arrays.
     EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere", "radius": 1e400}}})")
-                  .find("test.json: invalid JSON"),
+                  .find("test.json: /surface/shape/radius: expected a number, got 1e400, beyond "
+                        "the range of a double"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "fluid": {"gravity": [0, 0, -1e400]}})")
+                  .find("test.json: /fluid/gravity/2: expected a number, got -1e400"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"initial_velocity": [{"velocity": [1, 2, 3]}, {"velocity": [1, 2e999, 3]}]})")
+                  .find("test.json: /initial_velocity/1/velocity/1: expected a number, got 2e999"),
               std::string::npos);
     // Magnitudes whose products overflow.
     EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "fluid": {"gravity": [0, 0, -1e308]}})")
