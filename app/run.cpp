@@ -22,8 +22,10 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -211,13 +213,15 @@ struct FrameWork {
 /// fails, the frame's files already written are removed again.
 class FrameWriter {
 public:
-    FrameWriter(const Scene& scene, const std::string& dir) : m_scene(scene), m_dir(dir) {
+    FrameWriter(const Scene& scene, const std::string& dir)
+        : m_scene(scene),
+          m_dir(dir),
+          m_stats_path((std::filesystem::path(dir) / "stats.jsonl").string()) {
         std::filesystem::create_directories(dir);
-        const std::string stats_path = (std::filesystem::path(dir) / "stats.jsonl").string();
         errno = 0;
-        m_stats.open(stats_path, std::ios::trunc);
+        m_stats.open(m_stats_path, std::ios::trunc);
         if (!m_stats)
-            throw WriteError(stats_path + ": cannot open for writing: " +
+            throw WriteError(m_stats_path + ": cannot open for writing: " +
                              system_reason(errno, "open failed"));
         m_vdb.voxel_size = scene.output.voxel_size > 0.0 ? scene.output.voxel_size
                                                          : 0.5 * scene.surface.edge_length;
@@ -244,26 +248,45 @@ public:
                 coupling::write_surface_vdb(written.back(), mesh, m_vdb);
             }
         } catch (...) {
-            for (const std::string& path : written)
-                std::remove(path.c_str());
+            remove_files(written);
             throw;
         }
+        m_frame_files = std::move(written);
         return seconds_since(start);
     }
 
-    /// Appends the frame's line to stats.jsonl (what marks the frame complete).
+    /// Appends the frame's line to stats.jsonl (what marks the frame complete). When the line
+    /// cannot be written whole, stats.jsonl is cut back to its complete lines and the frame's
+    /// files are removed, so no frame is left half-recorded.
     void stats(const nlohmann::json& line) {
-        m_stats << line.dump() << '\n';
+        const std::string text = line.dump() + '\n';
+        errno = 0;
+        m_stats << text;
         m_stats.flush();
-        if (!m_stats)
-            throw WriteError(m_dir + "/stats.jsonl: write failed: " +
-                             system_reason(errno, "the stream reported an error"));
+        if (!m_stats) {
+            const std::string reason = system_reason(errno, "the stream reported an error");
+            m_stats.close();
+            std::error_code ec;
+            std::filesystem::resize_file(m_stats_path, m_stats_bytes, ec);
+            remove_files(m_frame_files);
+            throw WriteError(m_stats_path + ": write failed: " + reason);
+        }
+        m_stats_bytes += text.size();
+        m_frame_files.clear();
     }
 
 private:
+    static void remove_files(const std::vector<std::string>& paths) {
+        for (const std::string& path : paths)
+            std::remove(path.c_str());
+    }
+
     const Scene& m_scene;
     std::string m_dir;
+    std::string m_stats_path;
     std::ofstream m_stats;
+    std::uintmax_t m_stats_bytes = 0;       ///< bytes of complete lines in stats.jsonl
+    std::vector<std::string> m_frame_files;  ///< files of the frame whose line is not written yet
     coupling::VdbOutputOptions m_vdb;
 };
 

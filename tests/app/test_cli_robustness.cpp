@@ -14,8 +14,10 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -360,10 +362,16 @@ ChildResult run_and_signal(const fs::path& dir, const std::string& scene,
 }
 
 void expect_complete_frames_only(const fs::path& out) {
-    std::ifstream stats(out / "stats.jsonl");
+    std::ifstream stats(out / "stats.jsonl", std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(stats)), std::istreambuf_iterator<char>());
+    EXPECT_TRUE(text.empty() || text.back() == '\n') << "stats.jsonl ends in a partial line";
+    std::istringstream in(text);
     int lines = 0;
-    for (std::string line; std::getline(stats, line);)
+    for (std::string line; std::getline(in, line);) {
+        EXPECT_TRUE(line.size() > 2 && line.front() == '{' && line.back() == '}')
+            << "stats.jsonl line " << lines + 1 << " is not a whole JSON object: " << line;
         ++lines;
+    }
     for (const auto& entry : fs::directory_iterator(out)) {
         const std::string name = entry.path().filename().string();
         EXPECT_EQ(name.find(".partial"), std::string::npos) << name;
@@ -466,6 +474,27 @@ TEST_F(Robustness, FailedWritesAreExitOneNamingTheFileAndLeaveNothingUnderItsNam
         EXPECT_FALSE(fs::exists(out / file)) << describe(r);
         EXPECT_FALSE(fs::exists(out / (file + ".partial"))) << describe(r);
     }
+}
+
+TEST_F(Robustness, FailedStatsLineIsCutBackWithItsFrameFiles) {
+    // Frame 0's PLY (about 9 kB) fits under a 12 kB file-size bound, stats.jsonl (about
+    // 640 bytes a line) outgrows it near frame 19: the line that fails is cut back off and its
+    // frame's PLY removed, so every PLY left has a whole stats line.
+    std::string scene_text = small_scene(true, false);
+    scene_text.replace(scene_text.find("\"frames\": 2"), 11, "\"frames\": 40");
+    scene_text.replace(scene_text.find("\"end\": 0.04"), 11, "\"end\": 0.4");
+    const fs::path out = m_dir / "out";
+    ChildLimits limits = refusal_limits();
+    limits.file_size_bytes = 12000;
+    const ChildResult r = run(write("s.json", scene_text), {"--out", out.string()}, limits);
+    ASSERT_TRUE(r.exited) << describe(r);
+    EXPECT_EQ(r.exit_code, 1) << describe(r);
+    EXPECT_NE(r.output.find("cannot write output: " + (out / "stats.jsonl").string() +
+                            ": write failed: File too large"),
+              std::string::npos)
+        << describe(r);
+    ASSERT_TRUE(fs::exists(out / "surface_0005.ply")) << "the bound should hit stats.jsonl late";
+    expect_complete_frames_only(out);
 }
 
 TEST_F(Robustness, StalePartialFilesAreRemovedByTheNextRun) {
