@@ -204,20 +204,23 @@ MeshData read_surface_file(const Scene& scene) {
     if (data.triangles.empty())
         throw InputError(file + ": no faces (" + std::to_string(data.positions.size()) +
                          " vertices, 0 faces): the initial surface needs a closed triangle mesh");
+    // Before anything indexes the positions with them (the area estimate, the mesh).
+    const FileTerms terms(data);
+    const auto nv = static_cast<long long>(data.positions.size());
+    for (size_t ti = 0; ti < data.triangles.size(); ++ti)
+        for (int vi : data.triangles[ti])
+            if (vi < 0 || vi >= nv)
+                throw InputError(file + ": " + terms.face_of_triangle(static_cast<int>(ti)) +
+                                 " refers to " + terms.vertex(vi) + ", but the file has " +
+                                 std::to_string(nv) + " vertices (" + terms.numbering() + ")");
     return data;
 }
 
 SurfaceMesh checked_surface_mesh(const MeshData& data, const Scene& scene) {
     const std::string& file = scene.surface.mesh_file;
     const FileTerms terms(data);
-    const int nv = static_cast<int>(data.positions.size());
     for (size_t ti = 0; ti < data.triangles.size(); ++ti) {
         const tracker::Triangle& t = data.triangles[ti];
-        for (int vi : t)
-            if (vi < 0 || vi >= nv)
-                throw InputError(file + ": " + terms.face_of_triangle(static_cast<int>(ti)) +
-                                 " refers to " + terms.vertex(vi) + ", but the file has " +
-                                 std::to_string(nv) + " vertices (" + terms.numbering() + ")");
         if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
             throw InputError(file + ": " + terms.face_of_triangle(static_cast<int>(ti)) +
                              " uses a vertex twice (" + terms.vertices(t) +

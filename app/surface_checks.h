@@ -15,10 +15,11 @@
 namespace meniscus::app {
 
 /// Reads /surface/mesh_file (counts checked against the file's size before allocating).
-/// Throws InputError naming the file and the problem, including a file without faces.
+/// Throws InputError naming the file and the problem, including a file without faces and a
+/// face that refers to a vertex the file does not have.
 tracker::MeshData read_surface_file(const Scene& scene);
 
-/// Builds the mesh of `data` (read from `file`) and checks it: valid indices, closed (unless
+/// Builds the mesh of `data` (as read_surface_file() returns it) and checks it: closed (unless
 /// /surface/open), consistently oriented, no degenerate or duplicate faces, no
 /// self-intersection, outward orientation and alternating nesting (closed surfaces),
 /// coordinates within what doubles resolve at its edge lengths. Throws InputError listing the

@@ -306,6 +306,19 @@ TEST_F(Robustness, MeshProblemsUseTheFilesOwnNumbers) {
         << describe(range);
 }
 
+TEST_F(Robustness, FaceIndexFarBeyondTheVerticesIsRefusedBeforeAnythingReadsIt) {
+    // Was a crash (signal 11): the memory estimate summed the triangle areas before the
+    // indices were checked, reading position 2e9 of 6.
+    write("far_index.obj", std::string(OCTAHEDRON_OBJ) + "f 1 2 2000000000\n");
+    const ChildResult r = run(write("s.json", R"({"surface": {"mesh_file": "far_index.obj"}})"));
+    ASSERT_TRUE(r.exited) << describe(r);
+    EXPECT_EQ(r.exit_code, 2) << describe(r);
+    EXPECT_NE(r.output.find("far_index.obj: the face on line 15 refers to vertex 2000000000, but "
+                            "the file has 6 vertices"),
+              std::string::npos)
+        << describe(r);
+}
+
 TEST_F(Robustness, PlyCountsAreCheckedAgainstTheFileSize) {
     // A 9 KB binary PLY whose face count says 2e9: refused at once, within the memory bound.
     std::string ply =
