@@ -65,13 +65,25 @@ sanitize_build() {
   cmake --build "$SANITIZE_BUILD_DIR" -j "$(nproc)"
 }
 
+# Tests write scratch files under std::filesystem::temp_directory_path() by fixed names; a
+# private TMPDIR per ctest run keeps two suites on one machine (two clones or worktrees) from
+# removing each other's files mid-test. Removed afterwards.
+run_ctest() {
+  local scratch rc=0
+  scratch=$(mktemp -d "${TMPDIR:-/tmp}/meniscus_ctest.XXXXXX")
+  TMPDIR=$scratch ctest --output-on-failure -j "$(nproc)" "$@" || rc=$?
+  rm -rf "$scratch" 2>/dev/null || true
+  return $rc
+}
+
 cmd=${1:-run}
 shift || true
 install_missing
 if [ "$cmd" = sanitize ]; then
   sanitize_build
   cd "$SANITIZE_BUILD_DIR"
-  exec ctest --output-on-failure -j "$(nproc)" --timeout 1800 -E "$SANITIZE_EXCLUDE"
+  run_ctest --timeout 1800 -E "$SANITIZE_EXCLUDE"
+  exit
 fi
 build
 case "$cmd" in
@@ -82,7 +94,7 @@ case "$cmd" in
     ;;
   test)
     cd "$BUILD_DIR"
-    exec ctest --output-on-failure -j "$(nproc)" --timeout 900
+    run_ctest --timeout 900
     ;;
   build) ;;
   *) echo "usage: ./dev.sh [run [SCENE.json] [options] | test | sanitize | build]" >&2; exit 2 ;;
