@@ -126,26 +126,39 @@ FrameFormat frame_format(const Scene& scene) {
     return format;
 }
 
-void write_frame_files(const std::string& dir, int frame, const FrameFormat& format,
-                       const tracker::SurfaceMesh& mesh,
-                       const std::vector<tracker::Vec3>& velocities,
-                       const coupling::FluidFields& fluid) {
+std::vector<std::string> write_frame_files(const std::string& dir, int frame,
+                                           const FrameFormat& format,
+                                           const tracker::SurfaceMesh& mesh,
+                                           const std::vector<tracker::Vec3>& velocities,
+                                           const coupling::FluidFields& fluid) {
     const OutputOptions& o = format.output;
-    if (o.ply || o.obj) {
-        const OutputSurface surface = output_surface(mesh, velocities, format.vdb.length_scale);
-        if (o.ply)
-            tracker::write_ply(frame_path(dir, "surface", frame, "ply"), surface.mesh,
-                               o.ply_velocity ? &surface.velocities : nullptr);
-        if (o.obj)
-            tracker::write_obj(frame_path(dir, "surface", frame, "obj"), surface.mesh);
+    std::vector<std::string> written;
+    try {
+        if (o.ply || o.obj) {
+            const OutputSurface surface = output_surface(mesh, velocities, format.vdb.length_scale);
+            if (o.ply) {
+                written.push_back(frame_path(dir, "surface", frame, "ply"));
+                tracker::write_ply(written.back(), surface.mesh,
+                                   o.ply_velocity ? &surface.velocities : nullptr);
+            }
+            if (o.obj) {
+                written.push_back(frame_path(dir, "surface", frame, "obj"));
+                tracker::write_obj(written.back(), surface.mesh);
+            }
+        }
+        if (o.vdb) {
+            // The VDB's signs come from the same fans the PLY is split into (lengths in metres;
+            // the writer scales them).
+            const OutputSurface surface = output_surface(mesh, {}, 1.0);
+            written.push_back(frame_path(dir, "fields", frame, "vdb"));
+            coupling::write_surface_vdb(written.back(), surface.mesh, format.vdb, fluid);
+        }
+    } catch (...) {
+        for (const std::string& path : written)
+            std::remove(path.c_str());
+        throw;
     }
-    if (o.vdb) {
-        // The VDB's signs come from the same fans the PLY is split into (lengths in metres; the
-        // writer scales them).
-        const OutputSurface surface = output_surface(mesh, {}, 1.0);
-        coupling::write_surface_vdb(frame_path(dir, "fields", frame, "vdb"), surface.mesh,
-                                    format.vdb, fluid);
-    }
+    return written;
 }
 
 nlohmann::ordered_json run_sidecar(const Scene& scene, const FrameFormat& format,

@@ -63,10 +63,13 @@ FrameFormat frame_format(const Scene& scene);
 
 /// Writes frame `frame`'s files into `dir` (each atomically): the PLY (and OBJ) of
 /// output_surface() and the VDB of the same surface plus, when given, the fluid's fields.
-void write_frame_files(const std::string& dir, int frame, const FrameFormat& format,
-                       const tracker::SurfaceMesh& mesh,
-                       const std::vector<tracker::Vec3>& velocities,
-                       const coupling::FluidFields& fluid = {});
+/// Returns their paths. When one fails, those already written are removed and the error
+/// (WriteError for a failed write) is rethrown: a frame's files exist all or none.
+std::vector<std::string> write_frame_files(const std::string& dir, int frame,
+                                           const FrameFormat& format,
+                                           const tracker::SurfaceMesh& mesh,
+                                           const std::vector<tracker::Vec3>& velocities,
+                                           const coupling::FluidFields& fluid = {});
 
 /// The sidecar meniscus.json of a run of `scene` with `frames_written` of `frames_planned`
 /// frames after frame 0 written so far (frame 0 counts as written once it exists).

@@ -1,6 +1,7 @@
 #include "app/json_fields.h"
 
 #include <cmath>
+#include <cstdint>
 #include <iomanip>
 
 namespace meniscus::app {
@@ -26,6 +27,19 @@ std::string type_name(const nlohmann::json& j) {
         return "an array";
     return "an object";
 }
+
+/// Magnitudes a scene number may have (0 aside): Meniscus computes in SI units with doubles, and
+/// products of a few numbers beyond these overflow or underflow (1e308 m/s, a density of
+/// 1e-300); no physical scene needs them.
+constexpr double MAX_MAGNITUDE = 1e30;
+constexpr double MIN_MAGNITUDE = 1e-30;
+
+bool magnitude_supported(double v) {
+    const double a = std::abs(v);
+    return a == 0.0 || (a >= MIN_MAGNITUDE && a <= MAX_MAGNITUDE);
+}
+
+const char* MAGNITUDE_RULE = " (magnitudes outside [1e-30, 1e30] are not supported)";
 
 }  // namespace
 
@@ -79,6 +93,8 @@ void JsonReader::number(const char* key, double& value, Range range, const char*
     const double v = j->get<double>();
     if (!range.contains(v))
         fail(key, expected + ", got " + format_number(v));
+    if (!magnitude_supported(v))
+        fail(key, expected + ", got " + format_number(v) + MAGNITUDE_RULE);
     value = v;
 }
 
@@ -89,7 +105,10 @@ void JsonReader::integer(const char* key, int& value, Range range, const char*, 
     const std::string expected =
         "expected an integer" + (range.describe().empty() ? "" : " " + range.describe());
     if (!j->is_number_integer())
-        fail(key, expected + ", got " + type_name(*j));
+        fail(key, expected + ", got " + (j->is_number() ? format_number(j->get<double>()) : type_name(*j)));
+    if (j->is_number_unsigned() &&
+        j->get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<int>::max()))
+        fail(key, expected + ", got " + std::to_string(j->get<std::uint64_t>()));
     const long long v = j->get<long long>();
     if (!range.contains(static_cast<double>(v)) || v > std::numeric_limits<int>::max() ||
         v < std::numeric_limits<int>::min())
@@ -141,13 +160,23 @@ void JsonReader::vec3(const char* key, Eigen::Vector3d& value, Range range, cons
         return;
     const std::string expected =
         "expected an array of 3 numbers" + (range.describe().empty() ? "" : " " + range.describe());
-    if (!j->is_array() || j->size() != 3)
+    if (!j->is_array())
         fail(key, expected + ", got " + type_name(*j));
+    if (j->size() != 3)
+        fail(key, expected + ", got an array of " + std::to_string(j->size()));
     Eigen::Vector3d v;
     for (int i = 0; i < 3; ++i) {
         const auto& c = (*j)[static_cast<size_t>(i)];
-        if (!c.is_number() || !range.contains(c.get<double>()))
-            fail(std::string(key) + "/" + std::to_string(i), expected);
+        const std::string component = std::string(key) + "/" + std::to_string(i);
+        const std::string expected_component =
+            "expected a number" + (range.describe().empty() ? "" : " " + range.describe());
+        if (!c.is_number())
+            fail(component, expected_component + ", got " + type_name(c));
+        if (!range.contains(c.get<double>()))
+            fail(component, expected_component + ", got " + format_number(c.get<double>()));
+        if (!magnitude_supported(c.get<double>()))
+            fail(component, expected_component + ", got " + format_number(c.get<double>()) +
+                                MAGNITUDE_RULE);
         v[i] = c.get<double>();
     }
     value = v;

@@ -1,14 +1,18 @@
-/// The `meniscus` command line. Exit codes: 0 success, 1 internal failure, 2 bad input
-/// (arguments, scene, mesh file), 130 interrupted by Ctrl-C (all written files complete).
+/// The `meniscus` command line. Exit codes: 0 success, 1 internal failure or a failed write,
+/// 2 bad input (arguments, scene, mesh file, output folder), 130 / 143 stopped by SIGINT
+/// (Ctrl-C) / SIGTERM (all written frames complete).
 
 #include "app/json_fields.h"
+#include "app/resource_estimate.h"
 #include "app/run.h"
 #include "app/scene.h"
+#include "app/stop_signals.h"
 #include "app/validate.h"
+#include "common/assert.h"
+#include "common/atomic_file.h"
+#include "common/cancellation.h"
 
-#include <atomic>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -24,28 +28,25 @@ using namespace meniscus::app;
 constexpr int EXIT_OK = 0;
 constexpr int EXIT_INTERNAL = 1;
 constexpr int EXIT_BAD_INPUT = 2;
-constexpr int EXIT_INTERRUPTED = 130;
-
-std::atomic<bool> g_stop_requested{false};
-
-extern "C" void on_interrupt(int) {
-    g_stop_requested.store(true);
-    std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends the process at once
-}
 
 const char* USAGE =
     "usage: meniscus <command> [options]\n"
     "\n"
     "commands:\n"
     "  run SCENE.json [--out DIR] [--frames N] [--max-steps N] [--quiet]\n"
+    "                 [--max-memory GB] [--max-steps-per-frame N]\n"
     "        run a scene, writing per frame surface_NNNN.ply, fields_NNNN.vdb and a line of\n"
     "        stats.jsonl into DIR (default: out/), described by DIR/meniscus.json (units,\n"
     "        frame rate, files); an earlier run's frames in DIR are removed first. --frames N\n"
     "        overrides the scene's frame count (keeping its time per frame); --max-steps N\n"
     "        stops after N time steps (smoke tests).\n"
-    "        Ctrl-C stops after the current step; every file\n"
-    "        already written is complete.\n"
-    "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4|A6|B1|B2|B3|B4|B5]...\n"
+    "        Before it starts, the run's memory and time steps per frame are estimated; a\n"
+    "        scene above --max-memory (default: half the machine's memory) or\n"
+    "        --max-steps-per-frame (default 100000) is refused, naming what drives the estimate.\n"
+    "        Ctrl-C or SIGTERM stops within a second or two (the frame in progress is\n"
+    "        discarded; every frame whose stats.jsonl line is written is complete); a second\n"
+    "        one ends the program at once.\n"
+    "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4|A6|B1|...|B7]...\n"
     "           [--xi X]... [--curvature-operator cotangent|quartic_fit]...\n"
     "        run the validation cases — A: the paper's geometric flows (A1–A4; A5 is the cost\n"
     "        of A1's steps) and Zalesak's notched sphere turned once (A6), B: two-phase flow with\n"
@@ -63,7 +64,8 @@ const char* USAGE =
     "  --help     this text\n"
     "  --version  the version\n"
     "\n"
-    "exit codes: 0 success, 1 internal failure, 2 bad input, 130 interrupted\n";
+    "exit codes: 0 success, 1 internal failure or failed write (full disk), 2 bad input,\n"
+    "            130 stopped by Ctrl-C (SIGINT), 143 stopped by SIGTERM\n";
 
 class UsageError : public std::runtime_error {
 public:
@@ -79,6 +81,20 @@ int parse_positive_int(const std::string& flag, const std::string& text) {
         return static_cast<int>(v);
     } catch (const std::exception&) {
         throw UsageError(flag + ": expected a whole number from 1 to 1000000, got '" + text + "'");
+    }
+}
+
+/// A positive number (e.g. gigabytes) of at most `max`.
+double parse_positive_number(const std::string& flag, const std::string& text, double max,
+                             const char* what) {
+    try {
+        size_t used = 0;
+        const double v = std::stod(text, &used);
+        if (used != text.size() || !(v > 0.0) || !(v <= max))
+            throw std::out_of_range(text);
+        return v;
+    } catch (const std::exception&) {
+        throw UsageError(flag + ": expected " + what + ", got '" + text + "'");
     }
 }
 
@@ -112,6 +128,12 @@ int command_run(const std::vector<std::string>& args) {
             options.max_steps = parse_positive_int(a, value());
         else if (a == "--quiet")
             options.quiet = true;
+        else if (a == "--max-memory")
+            options.limits.max_memory_bytes =
+                1e9 * parse_positive_number(a, value(), 1e6, "a memory size in GB, up to 1e6");
+        else if (a == "--max-steps-per-frame")
+            options.limits.max_steps_per_frame = parse_positive_number(
+                a, value(), 1e15, "a number of time steps per frame, up to 1e15");
         else if (!a.empty() && a[0] == '-')
             throw UsageError("run: unknown option " + a);
         else if (scene_path.empty())
@@ -122,13 +144,13 @@ int command_run(const std::vector<std::string>& args) {
     }
     if (scene_path.empty())
         throw UsageError("run: no scene file given");
+    install_stop_signal_handlers();
     const Scene scene = load_scene(scene_path);
-    std::signal(SIGINT, on_interrupt);
-    const RunResult result = run_scene(scene, options, g_stop_requested);
+    const RunResult result = run_scene(scene, options, stop_requested_flag());
     if (result.interrupted) {
         std::fprintf(stderr, "meniscus: interrupted at t = %g s; frames 0..%d in %s are complete\n",
                      result.simulated_time, result.frames_written - 1, options.out_dir.c_str());
-        return EXIT_INTERRUPTED;
+        return stop_exit_code();
     }
     if (result.stalled) {
         std::fprintf(stderr,
@@ -204,8 +226,32 @@ int main(int argc, char** argv) {
     } catch (const InputError& e) {
         std::fprintf(stderr, "meniscus: bad input: %s\n", e.what());
         return EXIT_BAD_INPUT;
+    } catch (const meniscus::Cancelled&) {
+        std::fprintf(stderr, "meniscus: interrupted before the first frame was written\n");
+        return stop_exit_code();
+    } catch (const meniscus::WriteError& e) {
+        std::fprintf(stderr, "meniscus: cannot write output: %s\n", e.what());
+        return EXIT_INTERNAL;
+    } catch (const InternalFailure& e) {
+        std::fprintf(stderr,
+                     "meniscus: internal failure %s\n(a fault in meniscus, not in the input: "
+                     "please report it with the scene)\n",
+                     e.what());
+        return EXIT_INTERNAL;
+    } catch (const meniscus::InvariantError& e) {
+        std::fprintf(stderr,
+                     "meniscus: internal failure: broken invariant at %s\n(a fault in meniscus, "
+                     "not in the input: please report it with the scene)\n",
+                     e.what());
+        return EXIT_INTERNAL;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "meniscus: internal failure: out of memory\n");
+        return EXIT_INTERNAL;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "meniscus: internal failure: %s\n", e.what());
+        std::fprintf(stderr,
+                     "meniscus: internal failure: %s\n(a fault in meniscus, not in the input: "
+                     "please report it with the scene)\n",
+                     e.what());
         return EXIT_INTERNAL;
     }
 }

@@ -16,8 +16,13 @@ public:
              double min_line_seconds = 0.0);
     /// Frame `frame` of `frames` is done at simulated time `time` (s); `detail` is appended.
     void frame_done(int frame, int frames, double time, const std::string& detail);
-    /// Ends the bar (newline on a terminal).
+    /// Ends the bar (newline on a terminal). Idempotent.
     void finish();
+    /// Ends the bar too, so that a message after a run that was stopped by an exception (a
+    /// stop request inside a step) starts on its own line.
+    ~Progress() { finish(); }
+    Progress(const Progress&) = delete;
+    Progress& operator=(const Progress&) = delete;
 
 private:
     std::FILE* m_stream;

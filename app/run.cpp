@@ -1,7 +1,12 @@
 #include "app/run.h"
 
 #include "app/frame_output.h"
+#include "app/output_dir.h"
 #include "app/progress.h"
+#include "app/resource_estimate.h"
+#include "app/surface_checks.h"
+#include "common/atomic_file.h"
+#include "common/cancellation.h"
 #include "coupling/simulation.h"
 #include "coupling/vdb_output.h"
 #include "tracker/flows/curl_noise.h"
@@ -18,8 +23,10 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -36,6 +43,8 @@ using Clock = std::chrono::steady_clock;
 
 /// Violations listed in an error message before "and N more".
 constexpr size_t MAX_LISTED_VIOLATIONS = 5;
+/// The fluid grid's cells per axis are ints; its arrays are indexed by their products.
+constexpr double MAX_CELLS_PER_AXIS = 1 << 20;
 /// Geometric flows: a step that ends this close (fraction of /time/dt) to a stop lands on it.
 constexpr double TIME_SNAP_FRACTION = 1e-9;
 /// Geometric flows: the run stops (RunResult::stalled) after this many consecutive steps that
@@ -55,7 +64,7 @@ struct GeometricFlow {
     std::vector<double> breakpoints;  ///< times steps must end on (speed discontinuities)
 };
 
-GeometricFlow make_flow(const FlowOptions& flow) {
+GeometricFlow make_flow(const FlowOptions& flow, const CancellationToken& cancel) {
     // "fluid" scenes never get here (run_fluid_scene).
     GeometricFlow g;
     if (flow.type == "enright" || flow.type == "curl_noise" || flow.type == "rigid" ||
@@ -68,7 +77,7 @@ GeometricFlow make_flow(const FlowOptions& flow) {
             g.field = std::make_unique<tracker::RigidMotionField>(flow.rigid);
         else
             g.field = std::make_unique<tracker::ExpressionField>(flow.expression);
-        g.stepper = std::make_unique<tracker::VelocityFieldStepper>(*g.field);
+        g.stepper = std::make_unique<tracker::VelocityFieldStepper>(*g.field, cancel);
     } else if (flow.type == "normal_speed") {
         const NormalSpeedOptions& n = flow.normal_speed;
         const double speed = n.speed, reversal = n.reversal_time;
@@ -241,45 +250,81 @@ struct FrameWork {
     double volume_remeshing = 0.0, volume_motion = 0.0, volume_collisions = 0.0;
 };
 
-/// The run's output folder: removes an earlier run's files (frame_output.h), writes each frame's
-/// files and keeps the sidecar meniscus.json up to date (frames written, complete or not).
+/// The run's output folder. A frame is complete as a set: its files are written first (each
+/// atomically), its line of stats.jsonl next, then the sidecar meniscus.json that counts it, so a
+/// frame whose line is missing was cut short. When one file of a frame fails, the frame's files
+/// already written are removed again; an earlier run's files are removed first (frame_output.h).
 class FrameWriter {
 public:
     /// `frames`: the frames the run will write after frame 0.
     FrameWriter(const Scene& scene, const RunOptions& options, int frames)
-        : m_scene(scene), m_dir(options.out_dir), m_format(frame_format(scene)), m_frames(frames) {
+        : m_scene(scene),
+          m_dir(options.out_dir),
+          m_stats_path((std::filesystem::path(options.out_dir) / STATS_NAME).string()),
+          m_format(frame_format(scene)),
+          m_frames(frames) {
         const std::vector<std::string> removed = remove_earlier_run(m_dir);
         if (!removed.empty() && !options.quiet)
             std::fprintf(stderr, "%s: removed %zu files of an earlier run (%s ... %s)\n",
                          m_dir.c_str(), removed.size(), removed.front().c_str(),
                          removed.back().c_str());
         std::filesystem::create_directories(m_dir);
-        m_stats.open((std::filesystem::path(m_dir) / STATS_NAME).string(), std::ios::trunc);
+        errno = 0;
+        m_stats.open(m_stats_path, std::ios::trunc);
         if (!m_stats)
-            throw std::runtime_error(m_dir + "/" + STATS_NAME + ": cannot open for writing");
+            throw WriteError(m_stats_path + ": cannot open for writing: " +
+                             system_reason(errno, "open failed"));
     }
 
-    /// Writes the frame's files, then the sidecar; returns seconds spent.
+    /// Writes the frame's files; returns seconds spent.
     double write(int frame, const SurfaceMesh& mesh, const std::vector<Vec3>& velocities,
                  const coupling::FluidFields& fluid = {}) {
         const auto start = Clock::now();
-        write_frame_files(m_dir, frame, m_format, mesh, velocities, fluid);
-        write_run_sidecar(
-            m_dir, run_sidecar(m_scene, m_format, frame + 1, m_frames + 1, frame == m_frames));
+        m_frame_files = write_frame_files(m_dir, frame, m_format, mesh, velocities, fluid);
+        m_pending_frame = frame;
         return seconds_since(start);
     }
 
+    /// Appends the frame's line to stats.jsonl (what marks the frame complete), then rewrites
+    /// the sidecar to count the frame. When the line cannot be written whole, stats.jsonl is cut
+    /// back to its complete lines and the frame's files are removed, so no frame is left
+    /// half-recorded.
     void stats(const nlohmann::json& line) {
-        m_stats << line.dump() << '\n';
+        const std::string text = line.dump() + '\n';
+        errno = 0;
+        m_stats << text;
         m_stats.flush();
+        if (!m_stats) {
+            const std::string reason = system_reason(errno, "the stream reported an error");
+            m_stats.close();
+            std::error_code ec;
+            std::filesystem::resize_file(m_stats_path, m_stats_bytes, ec);
+            remove_files(m_frame_files);
+            throw WriteError(m_stats_path + ": write failed: " + reason);
+        }
+        m_stats_bytes += text.size();
+        m_frame_files.clear();
+        if (m_pending_frame >= 0)
+            write_run_sidecar(m_dir, run_sidecar(m_scene, m_format, m_pending_frame + 1,
+                                                 m_frames + 1, m_pending_frame == m_frames));
+        m_pending_frame = -1;
     }
 
 private:
+    static void remove_files(const std::vector<std::string>& paths) {
+        for (const std::string& path : paths)
+            std::remove(path.c_str());
+    }
+
     const Scene& m_scene;
     std::string m_dir;
+    std::string m_stats_path;
     FrameFormat m_format;
     int m_frames = 0;
     std::ofstream m_stats;
+    std::uintmax_t m_stats_bytes = 0;       ///< bytes of complete lines in stats.jsonl
+    std::vector<std::string> m_frame_files;  ///< files of the frame whose line is not written yet
+    int m_pending_frame = -1;                ///< the frame those files belong to
 };
 
 nlohmann::json frame_stats(int frame, double time, double dt, long long steps,
@@ -333,26 +378,60 @@ void check_intersection_free(const SurfaceMesh& mesh, const std::string& what) {
     throw InputError(s.str());
 }
 
+std::string format_length(double metres) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g m", metres);
+    return text;
+}
+
+/// "/surface/edge_length 0.02 m", or how a fluid scene derived it from the grid.
+std::string edge_length_keys(const Scene& scene) {
+    if (scene.flow.type == "fluid" && scene.coupling.edge_length_cells > 0.0)
+        return "edge length " + format_length(scene.surface.edge_length) +
+               " (/coupling/edge_length_cells x /domain/size/0 / /domain/cells)";
+    return "/surface/edge_length " + format_length(scene.surface.edge_length);
+}
+
+/// Total area of the triangles of `data` (m²).
+double mesh_data_area(const tracker::MeshData& data) {
+    double area = 0.0;
+    for (const tracker::Triangle& t : data.triangles) {
+        const Vec3& a = data.positions[static_cast<size_t>(t[0])];
+        area += 0.5 * (data.positions[static_cast<size_t>(t[1])] - a)
+                          .cross(data.positions[static_cast<size_t>(t[2])] - a)
+                          .norm();
+    }
+    return area;
+}
+
 }  // namespace
 
 /// The initial surface's geometry and connectivity (labels still the default: liquid inside).
+/// `preloaded`: the mesh file's contents when the caller has read them already.
 static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::string* report,
-                                                  double* nominal_xi) {
+                                                  double* nominal_xi,
+                                                  const tracker::MeshData* preloaded = nullptr) {
     if (scene.shape) {
         tracker::ImplicitMeshOptions options;
         options.edge_length = scene.surface.edge_length;
         options.remesh_iterations = scene.surface.remesh_iterations;
         options.crease = scene.surface.crease;
+        options.cancel = scene.cancel;
         tracker::ImplicitMeshReport r;
         SurfaceMesh mesh;
         try {
             mesh = tracker::mesh_implicit_shape(*scene.shape, options, &r);
-        } catch (const std::exception& e) {
-            throw InputError(scene.source_path + ": /surface: " + e.what());
+        } catch (const Cancelled&) {
+            throw;
+        } catch (const std::invalid_argument& e) {
+            throw InputError(scene.source_path + ": /surface/shape at " + edge_length_keys(scene) +
+                             ": " + e.what());
+        } catch (const std::runtime_error& e) {
+            throw InputError(scene.source_path + ": /surface/shape at " + edge_length_keys(scene) +
+                             ": " + e.what());
         }
-        check_intersection_free(mesh, scene.source_path +
-                                          ": /surface/shape meshed at edge_length " +
-                                          std::to_string(scene.surface.edge_length));
+        check_intersection_free(mesh, scene.source_path + ": /surface/shape meshed at " +
+                                          edge_length_keys(scene));
         if (report) {
             std::ostringstream s;
             s << "meshed shape: " << r.vertices << " vertices, " << r.triangles
@@ -369,25 +448,8 @@ static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::strin
         return mesh;
     }
     const std::string& file = scene.surface.mesh_file;
-    SurfaceMesh mesh;
-    try {
-        mesh = tracker::to_surface_mesh(tracker::read_mesh_file(file), file);
-    } catch (const std::runtime_error& e) {
-        throw InputError(e.what());
-    }
-    tracker::ValidationOptions validation;
-    validation.allow_boundary = scene.surface.open;
-    const auto violations = tracker::validate_mesh(mesh, validation);
-    if (!violations.empty()) {
-        std::ostringstream s;
-        s << file << ": not a valid " << (scene.surface.open ? "open" : "closed") << " surface (" << violations.size() << " problems):";
-        for (size_t i = 0; i < violations.size() && i < MAX_LISTED_VIOLATIONS; ++i)
-            s << "\n  " << tracker::to_string(violations[i].kind) << ": " << violations[i].message;
-        if (violations.size() > MAX_LISTED_VIOLATIONS)
-            s << "\n  ... and " << violations.size() - MAX_LISTED_VIOLATIONS << " more";
-        throw InputError(s.str());
-    }
-    check_intersection_free(mesh, file);
+    const tracker::MeshData data = preloaded ? tracker::MeshData{} : read_surface_file(scene);
+    SurfaceMesh mesh = checked_surface_mesh(preloaded ? *preloaded : data, scene);
     if (report) {
         std::ostringstream s;
         s << "loaded " << file << ": " << mesh.count_live_vertices() << " vertices, "
@@ -401,20 +463,81 @@ tracker::TrackerOptions tracker_options(const Scene& scene, double nominal_xi) {
     tracker::TrackerOptions options = scene.tracker;
     if (options.characteristic_length == 0.0)
         options.characteristic_length = nominal_xi;
+    options.cancel = scene.cancel;
     return options;
+}
+
+/// /surface/inside: which phase the surface encloses.
+static void set_inside_labels(SurfaceMesh& mesh, const Scene& scene) {
+    const tracker::LabelPair labels =
+        scene.surface.inside == "gas" ? tracker::LabelPair{0, 1} : tracker::LabelPair{1, 0};
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        if (mesh.triangle_alive(ti))
+            mesh.set_labels(ti, labels);
 }
 
 SurfaceMesh build_initial_surface(const Scene& scene, std::string* report, double* nominal_xi) {
     if (nominal_xi)
         *nominal_xi = 0.0;
     SurfaceMesh mesh = build_initial_surface_geometry(scene, report, nominal_xi);
-    // /surface/inside: which phase the surface encloses.
-    const tracker::LabelPair labels =
-        scene.surface.inside == "gas" ? tracker::LabelPair{0, 1} : tracker::LabelPair{1, 0};
-    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
-        if (mesh.triangle_alive(ti))
-            mesh.set_labels(ti, labels);
+    set_inside_labels(mesh, scene);
     return mesh;
+}
+
+/// The initial surface of `meniscus run`, after every check that can be made before the large
+/// allocations: the output folder, the scene's scale, a surface that meets the fluid box, and
+/// the estimated memory and steps per frame against `options.limits`.
+static SurfaceMesh checked_initial_surface(const Scene& scene, const RunOptions& options,
+                                           std::string* report, double* nominal_xi) {
+    *nominal_xi = 0.0;
+    prepare_output_dir(options.out_dir);
+    SurfaceSize size;
+    tracker::MeshData data;
+    if (scene.shape) {
+        size = shape_surface_size(scene);
+    } else {
+        data = read_surface_file(scene);
+        size.from_mesh_file = true;
+        size.triangles = static_cast<double>(data.triangles.size());
+        size.area = mesh_data_area(data);
+    }
+    const double frame_dt = scene.time.end / scene.time.frames;
+    check_resources(scene, estimate_resources(scene, size, frame_dt), options.limits);
+    check_scene_scale(scene);
+    if (scene.shape) {
+        const tracker::Box3 b = scene.shape->bounds();
+        check_surface_meets_fluid_box(scene, b.min(), b.max(), "/surface/shape");
+    }
+    SurfaceMesh mesh =
+        build_initial_surface_geometry(scene, report, nominal_xi, scene.shape ? nullptr : &data);
+    if (!scene.shape) {
+        Eigen::AlignedBox3d box;
+        for (const Vec3& p : data.positions)
+            box.extend(p);
+        check_surface_meets_fluid_box(scene, box.min(), box.max(),
+                                      "/surface/mesh_file " + scene.surface.mesh_file);
+    }
+    set_inside_labels(mesh, scene);
+    return mesh;
+}
+
+/// Turns an exception escaping a run's computation into what `meniscus run` reports: a stop
+/// request, a write error and bad input pass through; anything else is an internal failure at
+/// `where`.
+[[noreturn]] static void rethrow_with_context(const std::string& where) {
+    try {
+        throw;
+    } catch (const Cancelled&) {
+        throw;
+    } catch (const WriteError&) {
+        throw;
+    } catch (const InputError&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw InternalFailure("out of memory " + where);
+    } catch (const std::exception& e) {
+        throw InternalFailure(where + ": " + e.what());
+    }
 }
 
 /// True (with `result` filled in) when the run must stop before the next step: Ctrl-C or
@@ -432,10 +555,14 @@ bool should_stop(const RunOptions& options, const std::atomic<bool>& stop, doubl
 }
 
 /// Sets every face whose centre lies inside a region's shape to that region's velocity.
-void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::MacGrid& grid) {
+void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::MacGrid& grid,
+                            const CancellationToken& cancel) {
+    if (regions.empty())
+        return;
     for (int axis = 0; axis < 3; ++axis) {
         fluid::Array3<double>& u = grid.velocity(axis);
-        for (int k = 0; k < u.nk(); ++k)
+        for (int k = 0; k < u.nk(); ++k) {
+            cancel.throw_if_requested("setting the initial velocity");
             for (int j = 0; j < u.nj(); ++j)
                 for (int i = 0; i < u.ni(); ++i) {
                     const Vec3 x = grid.face_centre(axis, i, j, k);
@@ -443,6 +570,7 @@ void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::M
                         if (r.shape->value(x) < 0.0)
                             u(i, j, k) = r.velocity[axis];
                 }
+        }
     }
 }
 
@@ -538,26 +666,44 @@ nlohmann::json fluid_frame_stats(int frame, double time, long long steps,
     return line;
 }
 
-coupling::Simulation make_fluid_simulation(const Scene& scene, std::string* report) {
-    double nominal_xi = 0.0;
-    SurfaceMesh initial = build_initial_surface(scene, report, &nominal_xi);
+/// The coupled simulation of a fluid scene from its initial surface.
+static coupling::Simulation fluid_simulation(const Scene& scene, SurfaceMesh initial,
+                                             double nominal_xi) {
     const double dx = scene.domain.size.x() / scene.domain.cells;
-    const auto cells_along = [&](double size) {
-        return std::max(1, static_cast<int>(std::lround(size / dx)));
+    const auto cells_along = [&](double size, const char* key) {
+        const double n = std::round(size / dx);
+        if (!(n <= MAX_CELLS_PER_AXIS))
+            throw InputError(scene.source_path + ": " + key + ": " + std::to_string(n) +
+                             " cells of the /domain cell size; at most " +
+                             std::to_string(MAX_CELLS_PER_AXIS));
+        return std::max(1, static_cast<int>(n));
     };
-    fluid::FluidSolver solver(scene.domain.cells, cells_along(scene.domain.size.y()),
-                              cells_along(scene.domain.size.z()), dx, scene.domain.min,
-                              scene.fluid);
-    apply_initial_velocity(scene.initial_velocity, solver.grid());
+    fluid::FluidOptions options = scene.fluid;
+    options.pressure.iteration.cancel = scene.cancel;
+    options.viscosity.iteration.cancel = scene.cancel;
+    fluid::FluidSolver solver(scene.domain.cells, cells_along(scene.domain.size.y(), "/domain/size/1"),
+                              cells_along(scene.domain.size.z(), "/domain/size/2"), dx,
+                              scene.domain.min, options);
+    apply_initial_velocity(scene.initial_velocity, solver.grid(), scene.cancel);
     return coupling::Simulation(
         tracker::SurfaceTracker(std::move(initial), tracker_options(scene, nominal_xi)),
         std::move(solver), scene.coupling.simulation);
 }
 
-RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
-                          const std::atomic<bool>& stop) {
+coupling::Simulation make_fluid_simulation(const Scene& scene, std::string* report) {
+    double nominal_xi = 0.0;
+    SurfaceMesh initial = build_initial_surface(scene, report, &nominal_xi);
+    return fluid_simulation(scene, std::move(initial), nominal_xi);
+}
+
+/// Runs a fluid scene, keeping `result` current frame by frame (a caller that catches an
+/// exception still knows what was written).
+static void run_fluid_scene(const Scene& scene, const RunOptions& options,
+                            const std::atomic<bool>& stop, RunResult& result) {
     std::string report;
-    coupling::Simulation sim = make_fluid_simulation(scene, &report);
+    double nominal_xi = 0.0;
+    SurfaceMesh initial = checked_initial_surface(scene, options, &report, &nominal_xi);
+    coupling::Simulation sim = fluid_simulation(scene, std::move(initial), nominal_xi);
     const double dx = sim.fluid().grid().dx();
     if (!options.quiet)
         std::fprintf(stderr, "%s: %s; fluid grid %d x %d x %d, dx = %g m\n", scene.name.c_str(),
@@ -573,7 +719,6 @@ RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
         return coupling::FluidFields{&sim.fluid().grid(), &sim.fluid().pressure()};
     };
 
-    RunResult result;
     coupling::SimulationStepReport last;
     double output_seconds =
         writer.write(0, sim.tracker().mesh(), sim.vertex_velocities(), fields());
@@ -589,7 +734,7 @@ RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
         FrameSolves solves;
         while (t < t_frame) {
             if (should_stop(options, stop, t, progress, result))
-                return result;
+                return;
             last = sim.step(t_frame - t, scene.time.dt);
             solves.add(last.fluid);
             rasterize += last.rasterize_seconds;
@@ -633,12 +778,11 @@ RunResult run_fluid_scene(const Scene& scene, const RunOptions& options,
         progress.frame_done(frame, frames, t, detail);
     }
     progress.finish();
-    return result;
 }
 
-RunResult run_scene(const Scene& scene, const RunOptions& options, const std::atomic<bool>& stop) {
-    if (scene.flow.type == "fluid")
-        return run_fluid_scene(scene, options, stop);
+/// Runs a geometric-flow scene; see run_fluid_scene().
+static void run_geometric_scene(const Scene& scene, const RunOptions& options,
+                                const std::atomic<bool>& stop, RunResult& result) {
     const int frames = options.frames > 0 ? options.frames : scene.time.frames;
     // --frames keeps the time per frame of the scene.
     const double frame_dt = scene.time.end / scene.time.frames;
@@ -649,14 +793,16 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
 
     std::string report;
     double nominal_xi = 0.0;
-    SurfaceMesh initial = build_initial_surface(scene, &report, &nominal_xi);
+    SurfaceMesh initial = checked_initial_surface(scene, options, &report, &nominal_xi);
     tracker::SurfaceTracker tracker(std::move(initial), tracker_options(scene, nominal_xi));
     const SurfaceMesh& mesh = tracker.mesh();
     if (!options.quiet)
         std::fprintf(stderr, "%s: %s\n", scene.name.c_str(), report.c_str());
     if (exact.enabled())
         exact.check_initial(mesh, tracker.characteristic_length());
-    const GeometricFlow flow = make_flow(scene.flow);
+    for (const std::string& warning : plausibility_warnings(scene, tracker.characteristic_length()))
+        std::fprintf(stderr, "meniscus: warning: %s\n", warning.c_str());
+    const GeometricFlow flow = make_flow(scene.flow, scene.cancel);
 
     FrameWriter writer(scene, options, frames);
     Progress progress(stderr, options.quiet);
@@ -669,7 +815,6 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
         writer.stats(line);
     };
 
-    RunResult result;
     FrameWork work;
     work.output = writer.write(0, mesh, velocities);
     write_stats(0, 0.0, 0.0, 0, work);
@@ -683,7 +828,7 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
         work = FrameWork{};
         while (t < t_frame) {
             if (should_stop(options, stop, t, progress, result))
-                return result;
+                return;
             // Steps end exactly on frame times (unless /time/land_on_frames is off: then on the
             // end time only) and on the flow's breakpoints (A1's reversal).
             double next_stop = scene.time.land_on_frames ? t_frame : end_time;
@@ -741,7 +886,7 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
                 work.output = writer.write(frame, mesh, velocities);
                 write_stats(frame, t, dt, steps, work);
                 result.frames_written = frame + 1;
-                return result;
+                return;
             }
         }
         work.output = writer.write(frame, mesh, velocities);
@@ -753,6 +898,29 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
         progress.frame_done(frame, frames, t, detail);
     }
     progress.finish();
+}
+
+RunResult run_scene(const Scene& scene, const RunOptions& options, const std::atomic<bool>& stop) {
+    Scene stoppable = scene;
+    stoppable.cancel = CancellationToken(&stop);
+    RunResult result;
+    try {
+        if (scene.flow.type == "fluid")
+            run_fluid_scene(stoppable, options, stop, result);
+        else
+            run_geometric_scene(stoppable, options, stop, result);
+    } catch (const Cancelled&) {
+        // Stopped inside a step: the frame in progress is discarded, every frame written is
+        // complete. Before frame 0 there is nothing to report: the caller handles it.
+        if (result.frames_written == 0)
+            throw;
+        result.interrupted = true;
+    } catch (...) {
+        rethrow_with_context(result.frames_written == 0
+                                 ? std::string("while preparing the run")
+                                 : "in step " + std::to_string(result.steps + 1) + " (frame " +
+                                       std::to_string(result.frames_written) + ")");
+    }
     return result;
 }
 

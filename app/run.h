@@ -1,6 +1,7 @@
 #pragma once
 /// \file Running a scene: initial surface, time stepping, per-frame output.
 
+#include "app/resource_estimate.h"
 #include "app/scene.h"
 #include "tracker/mesh.h"
 
@@ -16,12 +17,20 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// A fault inside Meniscus (not the input's): exit code 1. The message says where it happened
+/// (the step and frame) and what failed.
+class InternalFailure : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 /// Command-line choices of `meniscus run`.
 struct RunOptions {
     std::string out_dir = "out";
     int frames = 0;           ///< > 0 overrides /time/frames, keeping the time per frame
     long long max_steps = 0;  ///< > 0 stops after this many steps (smoke tests)
     bool quiet = false;
+    ResourceLimits limits;  ///< estimated memory and steps per frame allowed before starting
 };
 
 /// How a run ended.
@@ -55,8 +64,15 @@ tracker::TrackerOptions tracker_options(const Scene& scene, double nominal_xi);
 /// Throws what build_initial_surface() and the fluid solver throw.
 coupling::Simulation make_fluid_simulation(const Scene& scene, std::string* report = nullptr);
 
-/// Runs the scene, writing frames into options.out_dir. Stops cleanly at the next step boundary
-/// once `stop` becomes true (every file already written is complete).
+/// Runs the scene, writing frames into options.out_dir. Before anything large is allocated it
+/// checks the output folder (InputError), the scene's scale and the estimated memory and steps
+/// per frame against options.limits (InputError naming the keys and the option to raise), and
+/// the initial surface (InputError). Once `stop` becomes true it stops at the next safe point —
+/// between steps, or inside a step's long loops (solver iterations, remeshing, collision
+/// rounds), discarding that frame — with RunResult::interrupted; every frame written is
+/// complete (its stats.jsonl line is written last). If `stop` comes before frame 0 is written,
+/// meniscus::Cancelled propagates. A failed write throws meniscus::WriteError; any other
+/// failure during the run InternalFailure saying where.
 RunResult run_scene(const Scene& scene, const RunOptions& options, const std::atomic<bool>& stop);
 
 }  // namespace meniscus::app

@@ -3,7 +3,9 @@
 #include "app/json_fields.h"
 #include "app/scene_shapes.h"
 
+#include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -25,6 +27,18 @@ const std::vector<std::pair<std::string, tracker::MeanCurvatureIntegrator>>
 const std::vector<std::pair<std::string, tracker::CurvatureOperator>> CURVATURE_OPERATORS = {
     {"cotangent", tracker::CurvatureOperator::cotangent},
     {"quartic_fit", tracker::CurvatureOperator::quartic_fit}};
+/// A scene file larger than this is refused before it is read (scenes are small; meshes go in
+/// mesh_file).
+constexpr std::uintmax_t MAX_SCENE_FILE_BYTES = 16u << 20;
+/// Curl noise: most modes in total (octaves × modes_per_octave; the shipped scenes use 24 to
+/// 72). A step evaluates every mode four times per vertex: 20 000 modes on 4 000 vertices took
+/// 14 s per step, 160 000 modes (16 octaves of 10 000) made two steps on 550 vertices take 46 s.
+constexpr long long MAX_CURL_NOISE_MODES = 4096;
+/// Most /initial_velocity regions (each is evaluated at every velocity face of the grid).
+constexpr size_t MAX_VELOCITY_REGIONS = 64;
+/// Deepest nesting of JSON arrays/objects accepted (the deepest shipped scene nests 6).
+constexpr int MAX_JSON_DEPTH = 64;
+
 const std::vector<std::string> EXACT_TYPES = {"none", "two_sphere_normal_flow",
                                               "sphere_mean_curvature", "rigid_motion"};
 
@@ -502,6 +516,10 @@ std::vector<VelocityRegion> parse_velocity_regions(const nlohmann::json& j) {
     const std::string path = "/initial_velocity";
     if (!j.is_array())
         throw SceneError(path + ": expected an array of {shape, velocity}");
+    if (j.size() > MAX_VELOCITY_REGIONS)
+        throw SceneError(path + ": " + std::to_string(j.size()) + " regions; at most " +
+                         std::to_string(MAX_VELOCITY_REGIONS) +
+                         " (every velocity face is tested against every region)");
     std::vector<VelocityRegion> regions;
     for (size_t i = 0; i < j.size(); ++i) {
         const std::string item = path + "/" + std::to_string(i);
@@ -544,6 +562,14 @@ void validate_flow(const Scene& scene, const nlohmann::json& j) {
     validate_at(f.curl_noise, "/flow/curl_noise/");
     validate_at(f.rigid, "/flow/rigid/");
     validate_at(f.expression, "/flow/expression/");
+    const long long modes =
+        static_cast<long long>(f.curl_noise.octaves) * f.curl_noise.modes_per_octave;
+    if (f.type == "curl_noise" && modes > MAX_CURL_NOISE_MODES)
+        throw SceneError("/flow/curl_noise: " + std::to_string(f.curl_noise.octaves) +
+                         " octaves x " + std::to_string(f.curl_noise.modes_per_octave) +
+                         " modes_per_octave = " + std::to_string(modes) + " modes; at most " +
+                         std::to_string(MAX_CURL_NOISE_MODES) +
+                         " (every vertex evaluates every mode four times per step)");
     validate_at(f.exact.sampling, "/flow/exact/");
     const ExactSolutionOptions& e = f.exact;
     if (e.type == "none") {
@@ -588,12 +614,117 @@ void validate_flow(const Scene& scene, const nlohmann::json& j) {
 }
 
 std::string read_file(const std::string& path) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (std::filesystem::is_directory(status))
+        throw SceneError(path + ": is a directory, not a scene file");
     std::ifstream in(path);
     if (!in)
         throw SceneError(path + ": cannot open the scene file");
+    const auto size = std::filesystem::is_regular_file(status)
+                          ? std::filesystem::file_size(path, ec)
+                          : std::uintmax_t{0};
+    if (!ec && size > MAX_SCENE_FILE_BYTES)
+        throw SceneError(path + ": " + std::to_string(size) +
+                         " bytes is too large for a scene file (at most " +
+                         std::to_string(MAX_SCENE_FILE_BYTES) + "; meshes go in mesh_file)");
     std::ostringstream s;
     s << in.rdbuf();
     return s.str();
+}
+
+/// Deepest nesting of arrays and objects in JSON text (brackets outside strings). Checked
+/// before parsing, so that no recursion over the document can run out of stack.
+int json_nesting_depth(const std::string& text) {
+    int depth = 0, deepest = 0;
+    bool in_string = false, escaped = false;
+    for (const char c : text) {
+        if (in_string) {
+            if (escaped)
+                escaped = false;
+            else if (c == '\\')
+                escaped = true;
+            else if (c == '"')
+                in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            deepest = std::max(deepest, ++depth);
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+    return deepest;
+}
+
+/// Finds where JSON text holds a number beyond the range of a double (1e400), which
+/// nlohmann::json::parse reports without a position: a SAX pass that follows the JSON pointer.
+class NumberOverflowLocator final : public nlohmann::json_sax<nlohmann::json> {
+public:
+    /// The JSON pointer of the value being parsed when the parse failed ("" before any).
+    std::string failed_path;
+    std::string failed_token;
+
+    bool null() override { return value(); }
+    bool boolean(bool) override { return value(); }
+    bool number_integer(number_integer_t) override { return value(); }
+    bool number_unsigned(number_unsigned_t) override { return value(); }
+    bool number_float(number_float_t, const string_t&) override { return value(); }
+    bool string(string_t&) override { return value(); }
+    bool binary(binary_t&) override { return value(); }
+    bool start_object(std::size_t) override { return open(false); }
+    bool start_array(std::size_t) override { return open(true); }
+    bool end_object() override { return close(); }
+    bool end_array() override { return close(); }
+    bool key(string_t& k) override {
+        std::string escaped;
+        for (const char c : k)
+            escaped += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
+        m_stack.back().segment = escaped;
+        return true;
+    }
+    bool parse_error(std::size_t, const std::string& last_token,
+                     const nlohmann::detail::exception&) override {
+        failed_token = last_token;
+        for (size_t i = 0; i < m_stack.size(); ++i) {
+            const Level& l = m_stack[i];
+            // The innermost array has not counted the element that failed.
+            const bool innermost = i + 1 == m_stack.size();
+            failed_path += "/" + (l.array && innermost ? std::to_string(l.count) : l.segment);
+        }
+        return false;
+    }
+
+private:
+    struct Level {
+        bool array = false;
+        long long count = 0;  ///< arrays: elements begun so far
+        std::string segment;  ///< the key or index of the value begun last
+    };
+    bool value() {
+        if (!m_stack.empty() && m_stack.back().array)
+            m_stack.back().segment = std::to_string(m_stack.back().count++);
+        return true;
+    }
+    bool open(bool array) {
+        value();
+        m_stack.push_back(Level{array, 0, ""});
+        return true;
+    }
+    bool close() {
+        m_stack.pop_back();
+        return true;
+    }
+    std::vector<Level> m_stack;
+};
+
+/// "/path: the number 1e400 is beyond ..." for a number nlohmann::json cannot hold.
+std::string number_overflow_message(const std::string& text) {
+    NumberOverflowLocator locator;
+    nlohmann::json::sax_parse(text, &locator);
+    const std::string where = locator.failed_path.empty() ? "(top level)" : locator.failed_path;
+    return where + ": expected a number, got " + locator.failed_token +
+           ", beyond the range of a double (magnitudes outside [1e-30, 1e30] are not supported)";
 }
 
 }  // namespace
@@ -601,10 +732,17 @@ std::string read_file(const std::string& path) {
 Scene parse_scene(const std::string& json_text, const std::string& source,
                   const std::string& base_dir) {
     try {
+        const int depth = json_nesting_depth(json_text);
+        if (depth > MAX_JSON_DEPTH)
+            throw SceneError("invalid scene: arrays and objects nested " + std::to_string(depth) +
+                             " deep (at most " + std::to_string(MAX_JSON_DEPTH) + ")");
         nlohmann::json j;
         try {
             j = nlohmann::json::parse(json_text);
-        } catch (const nlohmann::json::parse_error& e) {
+        } catch (const nlohmann::json::out_of_range&) {
+            // A number beyond the range of a double (1e400): the library names no position.
+            throw SceneError(number_overflow_message(json_text));
+        } catch (const nlohmann::json::exception& e) {
             throw SceneError(std::string("invalid JSON: ") + e.what());
         }
         Scene scene;

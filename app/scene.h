@@ -2,6 +2,7 @@
 /// \file Scene files: JSON (SI units) read into options structs. Every key has its default in
 /// the struct below and nowhere else; `meniscus scene-reference` prints them all.
 
+#include "common/cancellation.h"
 #include "coupling/simulation.h"
 #include "fluid/fluid_solver.h"
 #include "tracker/flows/curl_noise.h"
@@ -143,6 +144,8 @@ struct Scene {
     TimeOptions time;
     OutputOptions output;
     std::string source_path;  ///< the file it was read from
+    /// Stops meshing and stepping (set by run_scene() from its stop flag; never by the file).
+    CancellationToken cancel;
 };
 
 /// Reads and validates a scene file. Throws SceneError ("<file>: <json path>: <problem>") for

@@ -133,6 +133,19 @@ const std::vector<std::string> SHAPE_TYPES = {
     "sphere", "ellipsoid", "box",   "cylinder",     "perturbed_cylinder",
     "torus",  "dumbbell",  "wavy_half_space", "union", "intersection", "difference"};
 
+/// Limits on a shape tree: every evaluation of φ visits every primitive, and a combination's
+/// gradient re-evaluates its subtree at every level, so size and depth set the meshing cost.
+constexpr int MAX_SHAPE_DEPTH = 16;
+constexpr int MAX_SHAPE_PRIMITIVES = 256;
+
+/// Counts of the tree parsed so far (primitives) and where parsing is (depth).
+struct ShapeBudget {
+    int primitives = 0;
+};
+
+ShapePtr parse_shape_at(const nlohmann::json& j, const std::string& path, int depth,
+                        ShapeBudget& budget);
+
 template <typename Params>
 Params read_params(JsonReader& r) {
     Params p;
@@ -141,7 +154,8 @@ Params read_params(JsonReader& r) {
     return p;
 }
 
-std::vector<ShapePtr> parse_shape_list(JsonReader& r, const char* key) {
+std::vector<ShapePtr> parse_shape_list(JsonReader& r, const char* key, int depth,
+                                       ShapeBudget& budget) {
     r.known(key);
     if (!r.has(key))
         r.fail(key, "required: an array of shapes");
@@ -150,13 +164,16 @@ std::vector<ShapePtr> parse_shape_list(JsonReader& r, const char* key) {
         r.fail(key, "expected a non-empty array of shapes");
     std::vector<ShapePtr> shapes;
     for (size_t i = 0; i < list.size(); ++i)
-        shapes.push_back(parse_shape(list[i], r.path() + "/" + key + "/" + std::to_string(i)));
+        shapes.push_back(parse_shape_at(list[i], r.path() + "/" + key + "/" + std::to_string(i),
+                                        depth + 1, budget));
     return shapes;
 }
 
-}  // namespace
-
-ShapePtr parse_shape(const nlohmann::json& j, const std::string& path) {
+ShapePtr parse_shape_at(const nlohmann::json& j, const std::string& path, int depth,
+                        ShapeBudget& budget) {
+    if (depth > MAX_SHAPE_DEPTH)
+        throw SceneError(path + ": shapes nested more than " + std::to_string(MAX_SHAPE_DEPTH) +
+                         " deep (union, intersection and difference inside each other)");
     JsonReader r(j, path);
     std::string type;
     r.choice("type", type, SHAPE_TYPES, "");
@@ -164,6 +181,10 @@ ShapePtr parse_shape(const nlohmann::json& j, const std::string& path) {
         r.fail("type",
                "required: one of sphere, ellipsoid, box, cylinder, perturbed_cylinder, torus, "
                "dumbbell, wavy_half_space, union, intersection, difference");
+    const bool combination = type == "union" || type == "intersection" || type == "difference";
+    if (!combination && ++budget.primitives > MAX_SHAPE_PRIMITIVES)
+        throw SceneError(path + ": more than " + std::to_string(MAX_SHAPE_PRIMITIVES) +
+                         " primitive shapes in one shape tree");
     try {
         if (type == "sphere") {
             const auto p = read_params<SphereParams>(r);
@@ -201,7 +222,7 @@ ShapePtr parse_shape(const nlohmann::json& j, const std::string& path) {
                                                  p.wavelength);
         }
         if (type == "union" || type == "intersection") {
-            auto shapes = parse_shape_list(r, "shapes");
+            auto shapes = parse_shape_list(r, "shapes", depth, budget);
             r.finish();
             return type == "union" ? tracker::make_union(std::move(shapes))
                                    : tracker::make_intersection(std::move(shapes));
@@ -213,13 +234,20 @@ ShapePtr parse_shape(const nlohmann::json& j, const std::string& path) {
             r.fail("a", "required: the shape to subtract from");
         if (!r.has("b"))
             r.fail("b", "required: the shape to subtract");
-        ShapePtr a = parse_shape(r.raw("a"), path + "/a");
-        ShapePtr b = parse_shape(r.raw("b"), path + "/b");
+        ShapePtr a = parse_shape_at(r.raw("a"), path + "/a", depth + 1, budget);
+        ShapePtr b = parse_shape_at(r.raw("b"), path + "/b", depth + 1, budget);
         r.finish();
         return tracker::make_difference(std::move(a), std::move(b));
     } catch (const std::invalid_argument& e) {
         throw SceneError(path + ": " + e.what());
     }
+}
+
+}  // namespace
+
+ShapePtr parse_shape(const nlohmann::json& j, const std::string& path) {
+    ShapeBudget budget;
+    return parse_shape_at(j, path, 1, budget);
 }
 
 void add_shape_reference(std::vector<ReferenceWriter::Table>& tables) {

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -312,6 +313,17 @@ openvdb::FloatGrid::Ptr density_grid(const openvdb::FloatGrid& surface,
     return density;
 }
 
+/// io::File::write() with a stream we own: File::write() opens its own std::ofstream and never
+/// checks it, so a full disk left a truncated file; here the caller checks flush, close and
+/// size (commit_stream) before the rename. The bytes are those of io::File (a seekable archive
+/// with grid offsets, which readers such as Blender need).
+class CheckedArchive final : public openvdb::io::Archive {
+public:
+    void write_seekable(std::ostream& out, const openvdb::GridPtrVec& grids) const {
+        openvdb::io::Archive::write(out, grids, /*seekable=*/true);
+    }
+};
+
 }  // namespace
 
 void VdbOutputOptions::validate() const {
@@ -347,16 +359,15 @@ VdbOutputInfo write_surface_vdb(const std::string& path, const tracker::SurfaceM
     if (fluid.grid)
         append_fluid_grids(fluid, options, grids, info);
 
-    const std::string tmp = temporary_path_for(path);
+    std::ofstream out = open_temporary(path, std::ios::binary);
     try {
-        openvdb::io::File file(tmp);
-        file.write(grids);
-        file.close();
+        CheckedArchive().write_seekable(out, grids);
     } catch (const openvdb::Exception& e) {
-        std::remove(tmp.c_str());
-        throw std::runtime_error(path + ": cannot write VDB: " + e.what());
+        out.close();
+        std::remove(temporary_path_for(path).c_str());
+        throw WriteError(path + ": cannot write VDB: " + e.what());
     }
-    commit_temporary(path);
+    commit_stream(out, path);
     return info;
 }
 

@@ -44,6 +44,7 @@ SolveResult solve_pcg(const PoissonMatrix& matrix, const std::vector<double>& b,
     double rz = dot(r, z);
     result.residual = 1.0;
     for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
+        options.cancel.throw_if_requested("the PCG solve");
         matrix.apply(search, q);
         const double curvature = dot(search, q);
         if (!(curvature > 0.0)) {

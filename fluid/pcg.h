@@ -22,7 +22,8 @@ public:
 /// When `singular` is true A is taken to be a pure-Neumann operator whose null space is the
 /// constant over active cells: b, every residual and every preconditioned residual are projected
 /// to zero mean, and the returned x has zero mean. The residual is relative to the (projected) b.
-/// Returns {converged, iterations, residual}; never throws on non-convergence.
+/// Returns {converged, iterations, residual}; never throws on non-convergence. Throws
+/// meniscus::Cancelled when options.cancel is requested (checked every iteration).
 SolveResult solve_pcg(const PoissonMatrix& matrix, const std::vector<double>& b,
                       const Preconditioner& preconditioner, const IterativeSolverOptions& options,
                       bool singular, std::vector<double>& x);

@@ -10,7 +10,7 @@ namespace {
 
 void require(bool condition, const char* field, const char* what) {
     if (!condition) {
-        throw std::invalid_argument(std::string("PhaseOptions.") + field + " must be " + what);
+        throw std::invalid_argument(std::string("phases/") + field + ": must be " + what);
     }
 }
 

@@ -455,6 +455,7 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         result.residual = std::sqrt(dot(r, r)) / b_norm;
         result.converged = result.residual <= options.iteration.tolerance;
         while (!result.converged && result.iterations < options.iteration.max_iterations) {
+            options.iteration.cancel.throw_if_requested("the viscosity solve");
             op.apply(p, q);
             const double curvature = dot(p, q);
             if (!(curvature > 0.0)) {

@@ -182,6 +182,7 @@ public:
     /// last candidates when they still cover d, else builds new ones (with slack, for the next
     /// call); either way only pairs whose swept boxes overlap exactly are tested.
     std::vector<Contact> detect(const std::vector<Vec3>& d) {
+        m_o.cancel.throw_if_requested("collision resolution");
         std::vector<Vec3> x1(m_x0.size());
         for (size_t i = 0; i < x1.size(); ++i)
             x1[i] = m_x0[i] + d[i];

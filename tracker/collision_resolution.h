@@ -13,6 +13,7 @@
 /// shortening the step (x_t1 pulled back towards x_t0), then — if still not free — no motion at
 /// all. Every loop has a bound; what was used is reported. Never prints, never loops forever.
 
+#include "common/cancellation.h"
 #include "tracker/mesh.h"
 
 #include <cstdint>
@@ -35,6 +36,8 @@ struct CollisionOptions {
     /// few vertices, and assembling them asked for more memory than the machine had. A larger
     /// zone goes to the rigid-zone fallback (CollisionReport::oversized_zone_solves).
     int max_zone_matrix_entries = 20'000'000;
+    /// Checked before every detection round: throws meniscus::Cancelled once requested.
+    CancellationToken cancel;
     void validate() const;                ///< throws std::invalid_argument naming the field
 };
 

@@ -9,7 +9,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 #include <vector>
@@ -40,7 +42,8 @@ constexpr std::array<std::array<int, 4>, 6> KUHN_TETS = {
 
 class MarchingTetrahedra {
 public:
-    MarchingTetrahedra(const ImplicitShape& shape, double h) : m_shape(shape), m_h(h) {
+    MarchingTetrahedra(const ImplicitShape& shape, double h, const CancellationToken& cancel)
+        : m_shape(shape), m_h(h), m_cancel(cancel) {
         const Box3 b = shape.bounds();
         if (b.isEmpty())
             throw std::runtime_error("shape has empty bounds");
@@ -48,15 +51,22 @@ public:
             throw std::invalid_argument(
                 "shape is unbounded (e.g. a half-space): intersect it with a box");
         m_origin = b.min() - Vec3::Constant(PADDING_CELLS * h);
+        // Counted in double first: a huge shape or a tiny h must not overflow the int counts.
+        std::array<double, 3> n{};
         for (int i = 0; i < 3; ++i)
-            m_n[i] = static_cast<int>(std::ceil(b.sizes()[i] / h)) + 2 * PADDING_CELLS + 1;
-        const double nodes = double(m_n[0]) * m_n[1] * m_n[2];
-        if (nodes > MAX_NODES)
-            throw std::invalid_argument(
-                "edge_length: too small for the shape's size (the meshing grid would need " +
-                std::to_string(static_cast<long long>(nodes)) + " nodes)");
+            n[i] = std::ceil(b.sizes()[i] / h) + 2 * PADDING_CELLS + 1;
+        const double nodes = n[0] * n[1] * n[2];
+        if (!(nodes <= MAX_NODES) || !(h > 0.0)) {
+            std::ostringstream s;
+            s << "edge_length: too small for the shape's size (the meshing grid would need "
+              << std::setprecision(3) << nodes << " nodes, at most " << MAX_NODES << ")";
+            throw std::invalid_argument(s.str());
+        }
+        for (int i = 0; i < 3; ++i)
+            m_n[i] = static_cast<int>(n[i]);
         m_phi.resize(static_cast<size_t>(nodes));
-        for (int k = 0; k < m_n[2]; ++k)
+        for (int k = 0; k < m_n[2]; ++k) {
+            m_cancel.throw_if_requested("meshing the initial surface");
             for (int j = 0; j < m_n[1]; ++j)
                 for (int i = 0; i < m_n[0]; ++i) {
                     double v = shape.value(node_position(i, j, k));
@@ -64,13 +74,16 @@ public:
                         v = std::numeric_limits<double>::min();  // zero counts as outside
                     m_phi[node_index(i, j, k)] = v;
                 }
+        }
     }
 
     SurfaceMesh build() {
-        for (int k = 0; k + 1 < m_n[2]; ++k)
+        for (int k = 0; k + 1 < m_n[2]; ++k) {
+            m_cancel.throw_if_requested("meshing the initial surface");
             for (int j = 0; j + 1 < m_n[1]; ++j)
                 for (int i = 0; i + 1 < m_n[0]; ++i)
                     march_cube(i, j, k);
+        }
         return SurfaceMesh(std::move(m_positions), m_triangles);
     }
 
@@ -167,6 +180,7 @@ private:
 
     const ImplicitShape& m_shape;
     double m_h;
+    CancellationToken m_cancel;
     Vec3 m_origin;
     std::array<int, 3> m_n{};
     std::vector<double> m_phi;
@@ -224,6 +238,7 @@ int refine_creases(SurfaceMesh& mesh, const ImplicitShape& shape,
         crease.band > 0.0 ? crease.band : DEFAULT_CREASE_BAND_EDGES * options.edge_length;
     int splits = 0;
     for (int pass = 0; pass < crease.levels; ++pass) {
+        options.cancel.throw_if_requested("refining creases");
         const std::vector<Vec3> points =
             crease_points(mesh, shape, crease.angle, pass == 0 ? crease_vertices : nullptr);
         if (points.empty())
@@ -291,15 +306,19 @@ Vec3 project_to_zero_set(const ImplicitShape& shape, const Vec3& x, int iteratio
 SurfaceMesh mesh_implicit_shape(const ImplicitShape& shape, const ImplicitMeshOptions& options,
                                 ImplicitMeshReport* report) {
     options.validate();
-    MarchingTetrahedra marching(shape, GRID_SPACING_FRACTION * options.edge_length);
+    MarchingTetrahedra marching(shape, GRID_SPACING_FRACTION * options.edge_length,
+                                options.cancel);
     SurfaceMesh mesh = marching.build();
-    if (mesh.count_live_triangles() == 0)
-        throw std::runtime_error("the shape has no surface at edge_length " +
-                                 std::to_string(options.edge_length) +
-                                 " (is it smaller than one edge?)");
+    if (mesh.count_live_triangles() == 0) {
+        std::ostringstream s;
+        s << "the shape has no surface at edge_length " << options.edge_length
+          << " m (is it smaller than one edge?)";
+        throw std::runtime_error(s.str());
+    }
     IsotropicRemeshOptions remesh;
     remesh.target_edge_length = options.edge_length;
     remesh.iterations = options.remesh_iterations;
+    remesh.cancel = options.cancel;
     const int newton = options.projection_iterations;
     isotropic_remesh(mesh, remesh, [&shape, newton](const Vec3& p) {
         return project_to_zero_set(shape, p, newton);

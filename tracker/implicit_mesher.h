@@ -6,6 +6,7 @@
 /// root finding on φ, then isotropic remeshing with projection onto φ = 0 to reach the
 /// requested mean edge length without slivers. Normals point outward (towards φ > 0).
 
+#include "common/cancellation.h"
 #include "tracker/implicit_shape.h"
 #include "tracker/mesh.h"
 
@@ -41,6 +42,8 @@ struct ImplicitMeshOptions {
     int remesh_iterations = 8;      ///< isotropic remeshing iterations after marching tetrahedra
     int projection_iterations = 8;  ///< Newton steps onto φ = 0 per projected point
     CreaseRefinementOptions crease;
+    /// Checked per grid slab and remeshing pass: throws meniscus::Cancelled once requested.
+    CancellationToken cancel;
     void validate() const;          ///< throws std::invalid_argument naming the field
 };
 

@@ -27,6 +27,11 @@ public:
     virtual Eigen::Vector3d gradient(const Eigen::Vector3d& x) const;
     /// A box containing the whole region (the zero set and the inside).
     virtual Box3 bounds() const = 0;
+    /// An estimate of the area (m²) of the surface φ = 0 inside `within`, for sizing a mesh
+    /// before meshing: closed forms for the primitives (whole surface, `within` ignored; an
+    /// ellipsoid by Thomsen's formula), an upper bound for combinations (the sum of their parts,
+    /// each within the combination's bounds); +∞ for an unbounded surface in an unbounded box.
+    virtual double surface_area(const Box3& within) const = 0;
 };
 
 using ShapePtr = std::shared_ptr<const ImplicitShape>;

@@ -243,6 +243,7 @@ IsotropicRemeshReport isotropic_remesh(SurfaceMesh& mesh, const IsotropicRemeshO
     IsotropicRemeshReport report;
     Remesher remesher(mesh, options, project);
     for (int it = 0; it < options.iterations; ++it) {
+        options.cancel.throw_if_requested("remeshing the initial surface");
         report.splits += remesher.split_long_edges();
         report.collapses += remesher.collapse_short_edges();
         mesh.compact();

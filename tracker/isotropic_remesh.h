@@ -5,6 +5,7 @@
 /// collision-safe (the tracker's remeshing is) and assumes the target edge length resolves the
 /// surface's features.
 
+#include "common/cancellation.h"
 #include "tracker/mesh.h"
 
 #include <functional>
@@ -20,6 +21,7 @@ struct IsotropicRemeshOptions {
     double collapse_ratio = 4.0 / 5.0;  ///< collapse edges shorter than ratio · target
     /// Refuse collapses/flips that turn a triangle normal by more than this (degrees).
     double max_normal_change_degrees = 45.0;
+    CancellationToken cancel;  ///< checked every iteration (throws meniscus::Cancelled)
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
 

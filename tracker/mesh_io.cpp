@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -67,21 +68,6 @@ void put_le(std::ostream& out, T value) {
     if (!host_is_little_endian())
         std::reverse(bytes, bytes + sizeof(T));
     out.write(reinterpret_cast<const char*>(bytes), sizeof(T));
-}
-
-std::ofstream open_temporary(const std::string& path, std::ios::openmode mode) {
-    std::ofstream out(temporary_path_for(path), mode | std::ios::trunc);
-    if (!out)
-        fail(path, "cannot open for writing");
-    return out;
-}
-
-void finish(std::ofstream& out, const std::string& path) {
-    out.flush();
-    if (!out)
-        fail(path, "write failed (disk full?)");
-    out.close();
-    commit_temporary(path);
 }
 
 // ---- PLY reading ------------------------------------------------------------------------
@@ -181,17 +167,58 @@ int property_index(const PlyElement& e, const std::string& name) {
     return -1;
 }
 
+/// `index_base`: 1 for OBJ (messages show the file's own numbers), 0 for PLY.
 void add_polygon(MeshData& data, const std::vector<long long>& poly, const std::string& path,
-                 const std::string& where) {
+                 const std::string& where, int index_base) {
     if (poly.size() < 3)
         fail(path,
              where + ": a face needs at least 3 vertices, got " + std::to_string(poly.size()));
     for (long long v : poly)
         if (v < 0 || v > std::numeric_limits<int>::max())
-            fail(path, where + ": vertex index " + std::to_string(v) + " is out of range");
-    for (size_t k = 1; k + 1 < poly.size(); ++k)
+            fail(path, where + ": vertex index " + std::to_string(v + index_base) +
+                           " is out of range");
+    const int face = data.triangle_face.empty() ? 0 : data.triangle_face.back() + 1;
+    for (size_t k = 1; k + 1 < poly.size(); ++k) {
         data.triangles.push_back(
             {static_cast<int>(poly[0]), static_cast<int>(poly[k]), static_cast<int>(poly[k + 1])});
+        data.triangle_face.push_back(face);
+    }
+}
+
+/// Bytes one value of `type` takes at least in the file (ASCII: a digit and a separator).
+double min_value_bytes(PlyType type, PlyFormat format) {
+    if (format == PlyFormat::Ascii)
+        return 2.0;
+    switch (type) {
+        case PlyType::Int8:
+        case PlyType::UInt8:
+            return 1.0;
+        case PlyType::Int16:
+        case PlyType::UInt16:
+            return 2.0;
+        case PlyType::Int32:
+        case PlyType::UInt32:
+        case PlyType::Float32:
+            return 4.0;
+        case PlyType::Float64:
+            return 8.0;
+    }
+    return 1.0;
+}
+
+/// Smallest number of bytes one element can take (a face list has at least 3 entries).
+double min_element_bytes(const PlyElement& e, PlyFormat format) {
+    double bytes = 0.0;
+    for (const PlyProperty& p : e.properties) {
+        if (p.is_list) {
+            bytes += min_value_bytes(p.count_type, format);
+            if (e.name == "face")
+                bytes += 3.0 * min_value_bytes(p.type, format);
+        } else {
+            bytes += min_value_bytes(p.type, format);
+        }
+    }
+    return bytes;
 }
 
 }  // namespace
@@ -223,7 +250,7 @@ void write_ply(const std::string& path, const SurfaceMesh& mesh,
         for (int vi : t)
             put_le<std::int32_t>(out, vi);
     }
-    finish(out, path);
+    commit_stream(out, path);
 }
 
 void write_obj(const std::string& path, const SurfaceMesh& mesh) {
@@ -237,7 +264,7 @@ void write_obj(const std::string& path, const SurfaceMesh& mesh) {
     }
     for (const Triangle& t : d.triangles)
         out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
-    finish(out, path);
+    commit_stream(out, path);
 }
 
 MeshData read_ply(const std::string& path) {
@@ -303,6 +330,25 @@ MeshData read_ply(const std::string& path) {
     if (!have_format)
         fail(path, "PLY header has no format line");
 
+    // Counts are the file's claims: check them against what is left of it before reading.
+    const std::streamoff header_end = in.tellg();
+    in.seekg(0, std::ios::end);
+    const std::streamoff file_end = in.tellg();
+    in.seekg(header_end);
+    const double body_bytes = static_cast<double>(file_end - header_end);
+    double needed = 0.0;
+    for (const PlyElement& e : elements) {
+        if (e.count > 0 && e.properties.empty())
+            fail(path, "element '" + e.name + "' has no properties");
+        const double element_bytes = min_element_bytes(e, format);
+        needed += static_cast<double>(e.count) * element_bytes;
+        if (needed > body_bytes)
+            fail(path, "the header declares " + std::to_string(e.count) + " '" + e.name +
+                           "' elements of at least " + std::to_string(static_cast<int>(element_bytes)) +
+                           " bytes each, but only " + std::to_string(file_end - header_end) +
+                           " bytes follow the header (truncated file or wrong count)");
+    }
+
     MeshData data;
     PlyValueReader reader(in, format, path);
     for (const PlyElement& e : elements) {
@@ -329,6 +375,10 @@ MeshData read_ply(const std::string& path) {
                     const double count = reader.read(prop.count_type);
                     if (count < 0)
                         fail(path, "negative PLY list length");
+                    if (count * min_value_bytes(prop.type, format) > body_bytes)
+                        fail(path, e.name + " " + std::to_string(n) + ": a list of " +
+                                       std::to_string(static_cast<long long>(count)) +
+                                       " entries is longer than the file");
                     std::vector<long long> items(static_cast<size_t>(count));
                     for (auto& item : items)
                         item = static_cast<long long>(reader.read(prop.type));
@@ -358,7 +408,7 @@ MeshData read_ply(const std::string& path) {
                     data.velocities.push_back(v);
             }
             if (is_face)
-                add_polygon(data, poly, path, "face " + std::to_string(n));
+                add_polygon(data, poly, path, "face " + std::to_string(n), 0);
         }
     }
     return data;
@@ -399,13 +449,20 @@ MeshData read_obj(const std::string& path) {
                 poly.push_back(index > 0 ? index - 1
                                          : static_cast<long long>(data.positions.size()) + index);
             }
-            add_polygon(data, poly, path, where);
+            add_polygon(data, poly, path, where, 1);
+            data.face_line.push_back(line_no);
         }
     }
     return data;
 }
 
 MeshData read_mesh_file(const std::string& path) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (std::filesystem::is_directory(status))
+        fail(path, "is a directory, not a mesh file");
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+        fail(path, "is not a regular file");
     const auto dot = path.rfind('.');
     const std::string ext = dot == std::string::npos ? "" : lower(path.substr(dot));
     if (ext == ".ply")

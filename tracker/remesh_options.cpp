@@ -23,12 +23,12 @@ bool open_unit(double v) {
 }  // namespace
 
 void RemeshOptions::validate() const {
-    require(finite_positive(min_edge_fraction), "RemeshOptions::min_edge_fraction",
+    require(finite_positive(min_edge_fraction), "min_edge_fraction:",
             "must be finite and > 0");
     require(std::isfinite(max_edge_fraction) && max_edge_fraction > min_edge_fraction,
-            "RemeshOptions::max_edge_fraction", "must be finite and > min_edge_fraction");
+            "max_edge_fraction:", "must be finite and > min_edge_fraction");
     require(finite_positive(max_volume_change_fraction),
-            "RemeshOptions::max_volume_change_fraction", "must be finite and > 0");
+            "max_volume_change_fraction:", "must be finite and > 0");
     // Adaptive sizing terms: ≥ 0, and > 0 only with fitted split points.
     const auto adaptive_term = [this](double value, const char* field) {
         require(std::isfinite(value) && value >= 0.0, field, "must be finite and >= 0");
@@ -36,56 +36,56 @@ void RemeshOptions::validate() const {
                 "> 0 needs split_on_fitted_surface (butterfly points on graded meshes add "
                 "bumps that the curvature estimate then refines without end)");
     };
-    adaptive_term(curvature_edge_fraction, "RemeshOptions::curvature_edge_fraction");
-    adaptive_term(thin_sheet_sag_fraction, "RemeshOptions::thin_sheet_sag_fraction");
+    adaptive_term(curvature_edge_fraction, "curvature_edge_fraction:");
+    adaptive_term(thin_sheet_sag_fraction, "thin_sheet_sag_fraction:");
     require(std::isfinite(min_curvature_size_fraction) && min_curvature_size_fraction > 0.0 &&
                 min_curvature_size_fraction <= 1.0,
-            "RemeshOptions::min_curvature_size_fraction", "must be in (0, 1]");
-    require(max_split_passes >= 1, "RemeshOptions::max_split_passes", "must be >= 1");
-    require(max_collapse_passes >= 1, "RemeshOptions::max_collapse_passes", "must be >= 1");
-    require(max_flip_sweeps >= 1, "RemeshOptions::max_flip_sweeps", "must be >= 1");
+            "min_curvature_size_fraction:", "must be in (0, 1]");
+    require(max_split_passes >= 1, "max_split_passes:", "must be >= 1");
+    require(max_collapse_passes >= 1, "max_collapse_passes:", "must be >= 1");
+    require(max_flip_sweeps >= 1, "max_flip_sweeps:", "must be >= 1");
     require(std::isfinite(min_flip_length_decrease_fraction) &&
                 min_flip_length_decrease_fraction >= 0.0 && min_flip_length_decrease_fraction < 1.0,
-            "RemeshOptions::min_flip_length_decrease_fraction", "must be in [0, 1)");
-    require(collapse_position_attempts >= 1, "RemeshOptions::collapse_position_attempts",
+            "min_flip_length_decrease_fraction:", "must be in [0, 1)");
+    require(collapse_position_attempts >= 1, "collapse_position_attempts:",
             "must be >= 1");
     require(std::isfinite(max_normal_change_degrees) && max_normal_change_degrees > 0.0 &&
                 max_normal_change_degrees <= 180.0,
-            "RemeshOptions::max_normal_change_degrees", "must be in (0, 180]");
-    require(open_unit(ridge_eigenvalue_ratio), "RemeshOptions::ridge_eigenvalue_ratio",
+            "max_normal_change_degrees:", "must be in (0, 180]");
+    require(open_unit(ridge_eigenvalue_ratio), "ridge_eigenvalue_ratio:",
             "must be in (0, 1)");
-    require(open_unit(corner_eigenvalue_ratio), "RemeshOptions::corner_eigenvalue_ratio",
+    require(open_unit(corner_eigenvalue_ratio), "corner_eigenvalue_ratio:",
             "must be in (0, 1)");
     require(std::isfinite(flip_fold_weight) && flip_fold_weight >= 0.0,
-            "RemeshOptions::flip_fold_weight", "must be finite and >= 0");
-    require(smoothing_iterations >= 0, "RemeshOptions::smoothing_iterations", "must be >= 0");
+            "flip_fold_weight:", "must be finite and >= 0");
+    require(smoothing_iterations >= 0, "smoothing_iterations:", "must be >= 0");
     require(split_fit_residual_fraction > 0.0 && split_fit_residual_fraction <= 1.0,
-            "RemeshOptions::split_fit_residual_fraction", "must be in (0, 1]");
+            "split_fit_residual_fraction:", "must be in (0, 1]");
     require(smoothing_unfitted_min_angle_degrees >= 0.0 &&
                 smoothing_unfitted_min_angle_degrees <= 60.0,
-            "RemeshOptions::smoothing_unfitted_min_angle_degrees", "must be in [0, 60]");
+            "smoothing_unfitted_min_angle_degrees:", "must be in [0, 60]");
     require(smoothing_fit_degree == 2 || smoothing_fit_degree == 3,
-            "RemeshOptions::smoothing_fit_degree", "must be 2 or 3");
+            "smoothing_fit_degree:", "must be 2 or 3");
     require(std::isfinite(smoothing_fit_max_turn) && smoothing_fit_max_turn >= 0.0,
-            "RemeshOptions::smoothing_fit_max_turn", "must be finite and >= 0");
+            "smoothing_fit_max_turn:", "must be finite and >= 0");
     require(std::isfinite(smoothing_step_fraction) && smoothing_step_fraction > 0.0 &&
                 smoothing_step_fraction <= 1.0,
-            "RemeshOptions::smoothing_step_fraction", "must be in (0, 1]");
+            "smoothing_step_fraction:", "must be in (0, 1]");
 }
 
 void SeparationOptions::validate() const {
     require(std::isfinite(nudge_fraction) && nudge_fraction > 0.0 && nudge_fraction < 0.5,
-            "SeparationOptions::nudge_fraction", "must be in (0, 0.5)");
-    require(max_nudge_halvings >= 0, "SeparationOptions::max_nudge_halvings", "must be >= 0");
+            "separation/nudge_fraction:", "must be in (0, 0.5)");
+    require(max_nudge_halvings >= 0, "separation/max_nudge_halvings:", "must be >= 0");
 }
 
 void TopologyOptions::validate() const {
-    require(finite_positive(merge_distance_fraction), "TopologyOptions::merge_distance_fraction",
+    require(finite_positive(merge_distance_fraction), "merge_distance_fraction:",
             "must be finite and > 0");
     require(max_zipper_alignments >= 1 && max_zipper_alignments <= 4,
-            "TopologyOptions::max_zipper_alignments", "must be in [1, 4]");
+            "max_zipper_alignments:", "must be in [1, 4]");
     require(std::isfinite(merge_spacing_fraction) && merge_spacing_fraction >= 0.0,
-            "TopologyOptions::merge_spacing_fraction", "must be finite and >= 0");
+            "merge_spacing_fraction:", "must be finite and >= 0");
     separation.validate();
 }
 

@@ -208,6 +208,9 @@ struct ImproveContext {
     CollisionOptions collision;
     /// Used to clean up after collapses and flips when topology changes are allowed.
     SeparationOptions separation;
+    /// Checked between operations: throws meniscus::Cancelled once requested (the mesh is then
+    /// valid but only partly improved).
+    CancellationToken cancel;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
 
@@ -215,6 +218,7 @@ struct ImproveContext {
 struct TopologyContext {
     double xi = 0.0;               ///< ξ: initial mean edge length (metres, > 0)
     bool collision_safety = true;  ///< §3.3 switch: refuse merges whose triangles intersect
+    CancellationToken cancel;      ///< checked between merges (throws meniscus::Cancelled)
     void validate() const;         ///< throws std::invalid_argument naming the field
 };
 

@@ -47,6 +47,7 @@ SurfaceTracker::SurfaceTracker(SurfaceMesh mesh, const TrackerOptions& options)
     if (!(m_xi > 0.0))
         throw std::invalid_argument("SurfaceTracker: the mesh has no edges");
     m_options.collision.proximity_epsilon = m_options.proximity_fraction * m_xi;
+    m_options.collision.cancel = m_options.cancel;
 }
 
 ImproveReport SurfaceTracker::improve() {
@@ -58,6 +59,7 @@ ImproveReport SurfaceTracker::improve() {
     context.allow_topology_changes = m_options.allow_topology_changes;
     context.collision = m_options.collision;
     context.separation = m_options.topology.separation;
+    context.cancel = m_options.cancel;
     return improve_mesh(m_mesh, m_options.remesh, context);
 }
 
@@ -67,6 +69,7 @@ TopologyReport SurfaceTracker::change_topology() {
         TopologyContext context;
         context.xi = m_xi;
         context.collision_safety = m_options.collision_safety;
+        context.cancel = m_options.cancel;
         report = meniscus::tracker::change_topology(m_mesh, m_options.topology, context);
     }
     if (m_mesh.has_dead_elements())

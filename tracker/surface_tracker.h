@@ -32,6 +32,10 @@ struct TrackerOptions {
     CollisionOptions collision;
     RemeshOptions remesh;      ///< α, β, γ as fractions of ξ and the operations' switches
     TopologyOptions topology;  ///< merge distance and separation
+    /// Checked inside improve(), change_topology() and integrate(): they throw
+    /// meniscus::Cancelled once it is requested, leaving a valid mesh mid-operation (discard it
+    /// or keep stepping). Never requested by default.
+    CancellationToken cancel;
     void validate() const;     ///< throws std::invalid_argument naming the field
 };
 

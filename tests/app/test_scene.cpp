@@ -35,6 +35,69 @@ TEST(Scene, EveryShippedSceneParses) {
     EXPECT_GT(count, 0);
 }
 
+TEST(Scene, InputThatWouldOverflowOrNestWithoutBoundIsRefusedWithItsPath) {
+    // Numbers beyond a double (the JSON library's overflow, which has no position) name the
+    // file and the JSON path, also inside arrays.
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere", "radius": 1e400}}})")
+                  .find("test.json: /surface/shape/radius: expected a number, got 1e400, beyond "
+                        "the range of a double"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "fluid": {"gravity": [0, 0, -1e400]}})")
+                  .find("test.json: /fluid/gravity/2: expected a number, got -1e400"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"initial_velocity": [{"velocity": [1, 2, 3]}, {"velocity": [1, 2e999, 3]}]})")
+                  .find("test.json: /initial_velocity/1/velocity/1: expected a number, got 2e999"),
+              std::string::npos);
+    // Magnitudes whose products overflow.
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "fluid": {"gravity": [0, 0, -1e308]}})")
+                  .find("/fluid/gravity/2: expected a number, got -1e+308 (magnitudes outside"),
+              std::string::npos);
+    // Integers beyond long long are shown as written, not wrapped.
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "domain": {"cells": 18446744073709551615}})")
+                  .find("/domain/cells: expected an integer in [2, 4096], got 18446744073709551615"),
+              std::string::npos);
+    // Shape trees: depth and size are bounded.
+    std::string shape = R"({"type": "sphere"})";
+    for (int i = 0; i < 17; ++i)
+        shape = R"({"type": "difference", "a": )" + shape + R"(, "b": {"type": "sphere", "radius": 0.01}})";
+    EXPECT_NE(error_of(R"({"surface": {"shape": )" + shape + "}}")
+                  .find("/surface/shape/a/a/a/a/a/a/a/a/a/a/a/a/a/a/a/a: shapes nested more than 16 deep"),
+              std::string::npos);
+    std::string deep = "0";
+    for (int i = 0; i < 100; ++i)
+        deep = "[" + deep + "]";
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "name": )" + deep + "}")
+                  .find("arrays and objects nested 101 deep (at most 64)"),
+              std::string::npos);
+    std::string regions;
+    for (int i = 0; i < 65; ++i)
+        regions += std::string(i ? ", " : "") + R"({"shape": {"type": "sphere"}, "velocity": [1, 0, 0]})";
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "initial_velocity": [)" + regions + "]}")
+                  .find("/initial_velocity: 65 regions; at most 64"),
+              std::string::npos);
+    // Validation errors name the key the user wrote, not a C++ name.
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "tracker": {"topology": {"separation": {"nudge_fraction": 0.6}}}})")
+                  .find("/tracker/topology/separation/nudge_fraction: expected a number in (0, 0.5)"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"surface": {"shape": {"type": "sphere"}}, "flow": {"type": "curl_noise",
+                        "curl_noise": {"octaves": 16, "modes_per_octave": 10000}}})")
+                  .find("/flow/curl_noise: 16 octaves x 10000 modes_per_octave = 160000 modes; at "
+                        "most 4096"),
+              std::string::npos);
+}
+
+TEST(Scene, ADirectoryIsNotASceneFile) {
+    const auto dir = std::filesystem::temp_directory_path() / "meniscus_scene_dir.json";
+    std::filesystem::create_directories(dir);
+    try {
+        load_scene(dir.string());
+        ADD_FAILURE() << "a directory was read as a scene";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("is a directory, not a scene file"), std::string::npos);
+    }
+    std::filesystem::remove_all(dir);
+}
+
 TEST(Scene, DefaultsComeFromTheStructs) {
     const Scene s = parse_scene(R"({"surface": {"shape": {"type": "sphere"}}})", "t.json", ".");
     const Scene d;

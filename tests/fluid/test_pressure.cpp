@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -356,6 +357,34 @@ TEST(FluidPressureBackends, MultigridMatchesMic0OnOddGridsWithManyInterfaces) {
             }
             EXPECT_LT(difference, 1e-6 * scale);
         }
+    }
+}
+
+TEST(FluidPressureBackends, PcgStopsWhenCancelled) {
+    // A random velocity to project; a requested stop throws from the first PCG iteration.
+    const int n = 12;
+    MacGrid grid(n, n, n, 1.0 / n);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> random(-1.0, 1.0);
+    for (int axis = 0; axis < 3; ++axis)
+        for (double& value : grid.velocity(axis).storage())
+            value = random(rng);
+    grid.zero_wall_normal_velocity();
+    const InterfaceInput interface(grid);
+    for (PressureSolver solver : {PressureSolver::multigrid_pcg, PressureSolver::mic0_pcg}) {
+        std::atomic<bool> stop{true};
+        PressureOptions options = tight_options(solver);
+        options.iteration.cancel = CancellationToken(&stop);
+        Array3<double> pressure;
+        MacGrid copy = grid;
+        EXPECT_THROW(project(copy, interface, PhaseOptions{}, FluidMode::two_phase, 1e-3, options,
+                             pressure),
+                     Cancelled);
+        stop = false;
+        copy = grid;
+        EXPECT_TRUE(project(copy, interface, PhaseOptions{}, FluidMode::two_phase, 1e-3, options,
+                            pressure)
+                        .solve.converged);
     }
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 
@@ -244,6 +245,27 @@ TEST(FluidViscosity, TaylorGreenModeIsAnExactDiscreteEigenmode) {
         }
     }
     EXPECT_LT(max_error, 1e-10);
+}
+
+TEST(Viscosity, StopsWhenCancelled) {
+    // A shear flow to diffuse: the CG loop checks the token every iteration.
+    MacGrid grid(8, 8, 1, 0.125);
+    for (int j = 0; j < 8; ++j)
+        for (int i = 1; i < 8; ++i)
+            grid.u()(i, j, 0) = j < 4 ? 1.0 : -1.0;
+    InterfaceInput interface(grid);
+    PhaseOptions phases;
+    phases.mu_liquid = 1.0;
+    std::atomic<bool> stop{true};
+    ViscosityOptions options;
+    options.iteration.cancel = CancellationToken(&stop);
+    EXPECT_THROW(apply_viscosity(grid, interface, phases, FluidMode::two_phase,
+                                 WallOptions::all(WallType::no_slip), 0.01, options),
+                 Cancelled);
+    stop = false;
+    EXPECT_TRUE(apply_viscosity(grid, interface, phases, FluidMode::two_phase,
+                                WallOptions::all(WallType::no_slip), 0.01, options)
+                    .converged);
 }
 
 }  // namespace

@@ -6,11 +6,13 @@
 #include "tracker/mesh_intersections.h"
 #include "tracker/mesh_io.h"
 #include "tracker/mesh_measures.h"
+#include "tracker/mesh_validate.h"
 #include "tracker/surface_tracker.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <atomic>
 #include <random>
 #include <string>
 
@@ -105,6 +107,49 @@ TEST(CollisionResolution, RejectsBadInput) {
     EXPECT_THROW(resolve_collisions(m, m.positions(), x1, 0.0, o), std::invalid_argument);
     o.impulse_sweeps = -1;
     EXPECT_THROW(resolve_collisions(m, m.positions(), x1, 1.0, o), std::invalid_argument);
+}
+
+TEST(CollisionResolution, StopsWhenCancelled) {
+    SurfaceMesh m = small_tetrahedron_above_big_one();
+    std::vector<Vec3> x1 = m.positions();
+    for (int v = 4; v < 8; ++v)
+        x1[static_cast<size_t>(v)].z() -= 1.0;
+    std::atomic<bool> stop{true};
+    CollisionOptions o;
+    o.cancel = CancellationToken(&stop);
+    EXPECT_THROW(resolve_collisions(m, m.positions(), x1, 1.0, o), Cancelled);
+}
+
+TEST(SurfaceTracker, ImproveTopologyAndIntegrateStopWhenCancelledLeavingAValidMesh) {
+    std::atomic<bool> stop{false};
+    TrackerOptions options;
+    options.cancel = CancellationToken(&stop);
+    // Half the edges too long, so improvement has work to do.
+    SurfaceTracker tracker(meshed(make_sphere({0, 0, 0}, 0.3), 0.05), options);
+    for (int vi = 0; vi < tracker.mesh().num_vertices(); ++vi)
+        tracker.mesh().set_position(vi, 1.5 * tracker.mesh().position(vi));
+    stop = true;
+    EXPECT_THROW(tracker.improve(), Cancelled);
+    tracker.compact();
+    EXPECT_TRUE(validate_mesh(tracker.mesh()).empty());
+    EXPECT_TRUE(is_intersection_free(tracker.mesh()));
+    const std::vector<Vec3> velocities(static_cast<size_t>(tracker.mesh().num_vertices()),
+                                       Vec3(0.1, 0, 0));
+    EXPECT_THROW(tracker.integrate(velocities, 0.1), Cancelled);
+    stop = false;
+    tracker.improve();
+    tracker.change_topology();  // compacts
+    const std::vector<Vec3> moved(static_cast<size_t>(tracker.mesh().num_vertices()),
+                                  Vec3(0.1, 0, 0));
+    EXPECT_GT(tracker.integrate(moved, 0.1).time_advanced, 0.0);
+}
+
+TEST(VelocityFieldStepper, StopsWhenCancelled) {
+    std::atomic<bool> stop{true};
+    const CurlNoiseField field;
+    const SurfaceMesh m = meshed(make_sphere({0, 0, 0}, 0.3), 0.1);
+    EXPECT_THROW(VelocityFieldStepper(field, CancellationToken(&stop)).step(m, 0.0, 0.01),
+                 Cancelled);
 }
 
 /// A zone too large to assemble (CollisionOptions::max_zone_matrix_entries) goes to the rigid

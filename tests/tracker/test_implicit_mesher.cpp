@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
+#include <limits>
 #include <array>
 #include <cmath>
 #include <string>
@@ -314,6 +316,61 @@ TEST(ImplicitShapes, SignedDistancesOfPrimitives) {
     const auto diff = make_difference(make_sphere({0, 0, 0}, 1.0), make_sphere({1, 0, 0}, 0.5));
     EXPECT_GT(diff->value({0.9, 0, 0}), 0.0);
     EXPECT_LT(diff->value({-0.9, 0, 0}), 0.0);
+}
+
+TEST(ImplicitShapes, SurfaceAreasMatchTheirMeshes) {
+    // The closed forms the run's memory estimate uses: within 2 % of the meshed area for the
+    // primitives, and an upper bound for combinations (sum of parts).
+    constexpr double INF = std::numeric_limits<double>::infinity();
+    const Box3 everywhere(Vec3::Constant(-INF), Vec3::Constant(INF));
+    ImplicitMeshOptions options;
+    options.edge_length = 0.02;
+    const std::vector<std::pair<std::string, ShapePtr>> primitives = {
+        {"sphere", make_sphere({0, 0, 0}, 0.3)},
+        {"ellipsoid", make_ellipsoid({0, 0, 0}, {0.4, 0.2, 0.25})},
+        {"torus", make_torus({0, 0, 0}, {0, 0, 1}, 0.3, 0.1)},
+        {"perturbed_cylinder", make_perturbed_cylinder({0, 0, 0}, {1, 0, 0}, 0.1, 0.8, 0.1, 0.4)},
+    };
+    for (const auto& [name, shape] : primitives) {
+        const double meshed = surface_area(mesh_implicit_shape(*shape, options));
+        EXPECT_NEAR(shape->surface_area(everywhere), meshed, 0.02 * meshed) << name;
+    }
+    const ShapePtr two = make_union({make_sphere({-0.2, 0, 0}, 0.3), make_sphere({0.2, 0, 0}, 0.3)});
+    EXPECT_DOUBLE_EQ(two->surface_area(everywhere), 2.0 * 4.0 * M_PI * 0.09);
+    EXPECT_GT(two->surface_area(everywhere), surface_area(mesh_implicit_shape(*two, options)));
+    // An unbounded surface is finite only inside a box: a flat slab of 1 × 1 × 0.5.
+    const ShapePtr slab = make_intersection(
+        {make_wavy_half_space({0, 0, 0.5}, {0, 0, 1}, {1, 0, 0}, 0.0, 1.0),
+         make_box({0, 0, 0}, {1, 1, 2})});
+    EXPECT_TRUE(std::isinf(make_wavy_half_space({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, 0.0, 1.0)
+                               ->surface_area(everywhere)));
+    const double slab_area = slab->surface_area(everywhere);
+    EXPECT_TRUE(std::isfinite(slab_area));
+    EXPECT_GE(slab_area, 1.0 + 1.0 + 4 * 0.5);
+}
+
+TEST(ImplicitMesher, StopsWhenCancelled) {
+    std::atomic<bool> stop{true};
+    ImplicitMeshOptions options;
+    options.edge_length = 0.02;
+    options.cancel = CancellationToken(&stop);
+    EXPECT_THROW(mesh_implicit_shape(*make_sphere({0, 0, 0}, 0.3), options), Cancelled);
+    stop = false;
+    EXPECT_GT(mesh_implicit_shape(*make_sphere({0, 0, 0}, 0.3), options).count_live_triangles(), 0);
+}
+
+TEST(ImplicitMesher, HugeGridsAreRefusedWithTheirSizeNotAnOverflow) {
+    // Node counts beyond int used to overflow into a negative number in the message.
+    ImplicitMeshOptions options;
+    options.edge_length = 1e-12;
+    try {
+        mesh_implicit_shape(*make_sphere({0, 0, 0}, 1.0), options);
+        FAIL() << "a grid of 1e37 nodes was accepted";
+    } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("would need 2.33e+37 nodes"), std::string::npos) << what;
+        EXPECT_EQ(what.find('-'), std::string::npos) << what;
+    }
 }
 
 }  // namespace

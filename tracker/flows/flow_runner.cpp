@@ -64,7 +64,7 @@ FlowStep MeanCurvatureStepper::step(const SurfaceMesh& mesh, double /*t*/, doubl
 }
 
 FlowStep VelocityFieldStepper::step(const SurfaceMesh& mesh, double t, double dt_max) const {
-    return {rk4_displacements(mesh, *m_field, t, dt_max), dt_max, false};
+    return {rk4_displacements(mesh, *m_field, t, dt_max, m_cancel), dt_max, false};
 }
 
 double move_vertices(SurfaceMesh& mesh, const std::vector<Vec3>& displacements, double dt) {

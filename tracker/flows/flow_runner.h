@@ -78,11 +78,14 @@ private:
 /// offered step. The field is not owned and must outlive the stepper.
 class VelocityFieldStepper final : public FlowStepper {
 public:
-    explicit VelocityFieldStepper(const VelocityField& field) : m_field(&field) {}
+    /// `cancel` is checked per vertex (rk4_displacements()).
+    explicit VelocityFieldStepper(const VelocityField& field, CancellationToken cancel = {})
+        : m_field(&field), m_cancel(cancel) {}
     FlowStep step(const SurfaceMesh& mesh, double t, double dt_max) const override;
 
 private:
     const VelocityField* m_field;
+    CancellationToken m_cancel;
 };
 
 /// Moves the mesh by `displacements` over a step of `dt` seconds and returns the time actually

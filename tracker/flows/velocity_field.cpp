@@ -111,11 +111,12 @@ Vec3 ExpressionField::velocity(const Vec3& x, double t) const {
 }
 
 std::vector<Vec3> rk4_displacements(const SurfaceMesh& mesh, const VelocityField& field, double t,
-                                    double dt) {
+                                    double dt, const CancellationToken& cancel) {
     std::vector<Vec3> d(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
         if (!mesh.vertex_alive(vi))
             continue;
+        cancel.throw_if_requested("the velocity field");
         const Vec3 x = mesh.position(vi);
         const Vec3 k1 = field.velocity(x, t);
         const Vec3 k2 = field.velocity(x + 0.5 * dt * k1, t + 0.5 * dt);

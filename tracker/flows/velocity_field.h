@@ -4,6 +4,7 @@
 /// as expressions), and vertex advection by classical RK4 through them.
 
 #include "tracker/flows/expression.h"
+#include "common/cancellation.h"
 #include "tracker/mesh.h"
 
 #include <array>
@@ -93,8 +94,10 @@ private:
 };
 
 /// Displacements over [t, t + dt] of each live vertex of `mesh` by classical fourth-order
-/// Runge–Kutta through `field` (dead slots get zero). The mesh is not modified.
+/// Runge–Kutta through `field` (dead slots get zero). The mesh is not modified. Throws
+/// meniscus::Cancelled when `cancel` is requested (checked per vertex: a field of many modes
+/// makes each evaluation long).
 std::vector<Vec3> rk4_displacements(const SurfaceMesh& mesh, const VelocityField& field, double t,
-                                    double dt);
+                                    double dt, const CancellationToken& cancel = {});
 
 }  // namespace meniscus::tracker

@@ -352,6 +352,7 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
         int collapses_this_pass = 0;
         std::vector<std::uint8_t> changed(static_cast<size_t>(mesh.num_vertices()), 0);
         for (const auto& [fraction, scale, e] : short_edges) {
+            context.cancel.throw_if_requested("edge collapsing");
             const int ei = mesh.find_edge(e[0], e[1]);
             if (ei == INVALID_INDEX || edge_length(mesh, ei) >= limits.min_edge_length * scale)
                 continue;

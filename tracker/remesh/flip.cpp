@@ -162,6 +162,7 @@ FlipReport flip_edges(SurfaceMesh& mesh, const RemeshOptions& options,
     };
 
     for (int sweep = 0; sweep < options.max_flip_sweeps; ++sweep) {
+        context.cancel.throw_if_requested("edge flipping");
         ++report.sweeps;
         int flips_this_sweep = 0;
         const int edge_count = mesh.num_edges();

@@ -217,6 +217,7 @@ SmoothReport smooth_null_space(SurfaceMesh& mesh, const RemeshOptions& options,
     const auto start = std::chrono::steady_clock::now();
     SmoothReport report;
     for (int it = 0; it < options.smoothing_iterations; ++it) {
+        context.cancel.throw_if_requested("null-space smoothing");
         SmoothReport counts;
         const std::vector<Vec3> displacement = null_space_displacements(mesh, options, &counts);
         report.ridge_vertices = counts.ridge_vertices;

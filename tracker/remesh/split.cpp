@@ -102,6 +102,7 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
                   [](const LongEdge& a, const LongEdge& b) { return a.excess > b.excess; });
         int splits_this_pass = 0;
         for (const auto& [excess, alpha, e] : long_edges) {
+            context.cancel.throw_if_requested("edge splitting");
             const int ei = mesh.find_edge(e[0], e[1]);
             if (ei == INVALID_INDEX || edge_length(mesh, ei) <= alpha)
                 continue;

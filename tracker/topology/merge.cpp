@@ -165,6 +165,7 @@ MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& optio
     const double spacing = options.merge_spacing_fraction * context.xi;
     std::vector<Vec3> merged_at;
     for (const Candidate& c : candidates) {
+        context.cancel.throw_if_requested("merging");
         const bool near_merge = std::any_of(merged_at.begin(), merged_at.end(), [&](const Vec3& m) {
             return (m - c.midpoint).squaredNorm() < spacing * spacing;
         });
