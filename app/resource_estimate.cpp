@@ -245,6 +245,17 @@ ResourceEstimate estimate_resources(const Scene& scene, const SurfaceSize& surfa
         } else if (scene.flow.type == "curl_noise") {
             speed = CURL_NOISE_PEAK_OVER_RMS * scene.flow.curl_noise.rms_speed;
             speed_keys = "/flow/curl_noise/rms_speed (peaks about 4x)";
+        } else if (scene.flow.type == "rigid" && !surface.bounds.isEmpty()) {
+            // |v + ω × (x − c(t))| ≤ |v| + |ω| |x − c(t)|, and |x − c(t)| keeps its initial
+            // value (the motion turns x about c(t)): the farthest corner of the initial bounds.
+            const tracker::RigidMotionOptions& r = scene.flow.rigid;
+            double reach = 0.0;
+            for (int corner = 0; corner < 8; ++corner)
+                reach = std::max(reach, (surface.bounds.corner(static_cast<tracker::Box3::CornerType>(
+                                             corner)) - r.center).norm());
+            speed = r.velocity.norm() + r.angular_velocity.norm() * reach;
+            speed_keys = "/flow/rigid (|velocity| + |angular_velocity| x the surface's distance "
+                         "from /flow/rigid/center)";
         }
         // The offered step: an expanding surface is not shortened by the inversion limit.
         const double offered = scene.time.dt;

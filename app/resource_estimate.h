@@ -53,6 +53,8 @@ struct SurfaceSize {
     double area = 0.0;              ///< m²
     double triangles = 0.0;         ///< 0: from the area and the edge length
     bool from_mesh_file = false;    ///< true: no meshing grid
+    /// The initial surface's bounding box (empty: unknown); bounds the speed of a rigid flow.
+    tracker::Box3 bounds;
 };
 
 /// The surface size of `scene` when it has a shape (from_mesh_file false).

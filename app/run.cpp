@@ -495,11 +495,14 @@ static SurfaceMesh checked_initial_surface(const Scene& scene, const RunOptions&
     tracker::MeshData data;
     if (scene.shape) {
         size = shape_surface_size(scene);
+        size.bounds = scene.shape->bounds();
     } else {
         data = read_surface_file(scene);
         size.from_mesh_file = true;
         size.triangles = static_cast<double>(data.triangles.size());
         size.area = mesh_data_area(data);
+        for (const Vec3& p : data.positions)
+            size.bounds.extend(p);
     }
     const double frame_dt = scene.time.end / scene.time.frames;
     check_resources(scene, estimate_resources(scene, size, frame_dt), options.limits);

@@ -14,8 +14,11 @@ namespace meniscus::app {
 namespace {
 
 SurfaceSize surface_size(const Scene& scene) {
-    if (scene.shape)
-        return shape_surface_size(scene);
+    if (scene.shape) {
+        SurfaceSize s = shape_surface_size(scene);
+        s.bounds = scene.shape->bounds();
+        return s;
+    }
     // Shipped mesh files are small: the estimate from the file's area and triangle count.
     SurfaceSize s;
     s.from_mesh_file = true;
@@ -96,6 +99,29 @@ TEST(ResourceEstimate, RefusalsNameTheOptionThatRaisesTheLimit) {
     } catch (const InputError& error) {
         EXPECT_NE(std::string(error.what()).find("raise the limit with --max-steps-per-frame N"),
                   std::string::npos);
+    }
+}
+
+TEST(ResourceEstimate, RigidTurnAboutAFarCentreIsRefusedBeforeItStarts) {
+    // Found by the fuzz test: Zalesak's scene turned about a centre 5e8 m away moves its surface
+    // by 3e9 m/s; the run started and spent minutes on steps that each moved it by thousands of
+    // edge lengths. The rigid flow's speed is now bounded from the surface's bounds.
+    Scene scene =
+        load_scene(std::string(MENISCUS_SOURCE_DIR) + "/scenes/flows/zalesak_xi0.02.json");
+    const ResourceEstimate shipped =
+        estimate_resources(scene, surface_size(scene), frame_time(scene));
+    EXPECT_NO_THROW(check_resources(scene, shipped, ResourceLimits{}));
+    // The shipped turn: 2π rad/s at up to about 0.4 m from the axis (0.25 + 0.15, corners more).
+    EXPECT_GT(shipped.step_motion, 2.0 * M_PI * 0.4 * scene.time.dt);
+    scene.flow.rigid.center.x() = 5e8;
+    const ResourceEstimate far = estimate_resources(scene, surface_size(scene), frame_time(scene));
+    EXPECT_NEAR(far.step_motion, 2.0 * M_PI * 5e8 * scene.time.dt, 1e-6 * far.step_motion);
+    try {
+        check_resources(scene, far, ResourceLimits{});
+        FAIL() << "a step of " << far.step_motion << " m was accepted";
+    } catch (const InputError& error) {
+        EXPECT_NE(std::string(error.what()).find("/flow/rigid"), std::string::npos)
+            << error.what();
     }
 }
 
