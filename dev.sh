@@ -17,8 +17,9 @@ SANITIZE_BUILD_DIR=${MENISCUS_SANITIZE_BUILD_DIR:-build-sanitize}
 # tests of tracker, fluid, coupling and app, the command-line robustness tests (signals, checked
 # writes, refused input) and 2 of the 8 fuzz shards (80 cases). It leaves out what runs the same
 # code for minutes (several times longer under the sanitizers): the validation suite, the shipped
-# scene runs and physics checks, convergence studies, long stress runs and the render path
-# through Blender (together about 84 % of the suite's time).
+# scene runs and physics checks, convergence studies, long stress runs, the render path
+# through Blender and the resume tests that kill runs by the clock (together about 84 % of the
+# suite's time); the resume tests of damaged checkpoints and changed scenes stay in.
 SANITIZE_EXCLUDE='QuickValidation|SceneRuns|ScenePhysics|FlowScenes\.(ShrinkingSphere|ThinSheet|CurlNoiseStretches)'
 SANITIZE_EXCLUDE+='|CollisionStress\.(SphereCrushed|SpheresDrivenHeadOn)|CollisionRegression|MeanCurvature\.JustPinched'
 SANITIZE_EXCLUDE+='|AxisymmetricDumbbell\.(Agrees|Converges|HandlePinches)|AxisymmetricMcfReference\.SphereShrinks'
@@ -26,6 +27,7 @@ SANITIZE_EXCLUDE+='|LevelSetReference\.(SphereFollows|DumbbellPinches)|Simulatio
 SANITIZE_EXCLUDE+='|CcdFalsePositives\.NearDegenerate|RemeshAccuracy\.SplitsAtThinFolds|FluidViscosity\.(TwoLayer|Poiseuille)'
 SANITIZE_EXCLUDE+='|FluidSolver\.TaylorGreenVortexDecay|DropMerge\.TwoDrops|SurfaceTension\.(StaticDropThrough|SmoothingReduces)'
 SANITIZE_EXCLUDE+='|FuzzRun.*/[2-7]$|RenderPath|FluidScenes\.TimeDtCapsTheFluidStep'
+SANITIZE_EXCLUDE+='|Resume\.(FluidRunKilled|GeometricFlowKilled|OneAndTwoThreads)'
 # Any finding ends the program with exit code 86 (tests then fail); LeakSanitizer included.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-exitcode=86:detect_leaks=1:strict_string_checks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-exitcode=86:print_stacktrace=1}

@@ -1,5 +1,7 @@
 #include "app/frame_output.h"
 
+#include "app/checkpoint.h"
+
 #include "common/atomic_file.h"
 #include "tracker/mesh_io.h"
 #include "tracker/topology/separate.h"
@@ -46,7 +48,8 @@ bool is_run_file(std::string name) {
     if (name.size() > partial.size() &&
         name.compare(name.size() - partial.size(), partial.size(), partial) == 0)
         name.resize(name.size() - partial.size());
-    return name == STATS_NAME || name == SIDECAR_NAME || is_frame_name(name, "surface", "ply") ||
+    return name == STATS_NAME || name == SIDECAR_NAME || name == CHECKPOINT_NAME ||
+           is_frame_name(name, "surface", "ply") ||
            is_frame_name(name, "surface", "obj") || is_frame_name(name, "fields", "vdb");
 }
 
@@ -80,6 +83,34 @@ std::vector<std::string> remove_earlier_run(const std::string& dir) {
         if (!fs::remove(entry.path(), ec) && ec)
             throw std::runtime_error(entry.path().string() +
                                      ": cannot remove the earlier run's file: " + ec.message());
+        removed.push_back(name);
+    }
+    std::sort(removed.begin(), removed.end());
+    return removed;
+}
+
+std::vector<std::string> remove_frames_after(const std::string& dir, int frame) {
+    std::vector<std::string> removed;
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+        return removed;
+    for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+        const std::string name = entry.path().filename().string();
+        if (!entry.is_regular_file(ec) || !is_run_file(name))
+            continue;
+        const bool partial = name.size() > temporary_path_for("").size() &&
+                             name.compare(name.size() - temporary_path_for("").size(),
+                                          std::string::npos, temporary_path_for("")) == 0;
+        const size_t underscore = name.find('_');
+        const bool later_frame = underscore != std::string::npos &&
+                                 std::isdigit(static_cast<unsigned char>(name[underscore + 1])) &&
+                                 std::stoll(name.substr(underscore + 1, 18)) > frame;
+        if (!partial && !later_frame)
+            continue;
+        if (!fs::remove(entry.path(), ec) && ec)
+            throw std::runtime_error(entry.path().string() +
+                                     ": cannot remove a file written after the checkpoint: " +
+                                     ec.message());
         removed.push_back(name);
     }
     std::sort(removed.begin(), removed.end());

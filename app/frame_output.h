@@ -31,10 +31,15 @@ double metres_per_unit(const std::string& length_unit);
 std::string frame_path(const std::string& dir, const char* stem, int frame, const char* ext);
 
 /// Removes the files a run of ours writes — surface_N.ply, surface_N.obj, fields_N.vdb (N of at
-/// least FRAME_DIGITS digits), their `.partial` temporaries, stats.jsonl and meniscus.json — from
+/// least FRAME_DIGITS digits), their `.partial` temporaries, stats.jsonl, meniscus.json and
+/// checkpoint.bin — from
 /// `dir`, leaving every other file alone; returns the names removed (sorted). A missing folder
 /// removes nothing. Throws std::runtime_error naming the file that cannot be removed.
 std::vector<std::string> remove_earlier_run(const std::string& dir);
+
+/// Removes the frame files of frames after `frame` and every temporary a run of ours left in
+/// `dir` (a resumed run rewrites them); returns the names removed (sorted).
+std::vector<std::string> remove_frames_after(const std::string& dir, int frame);
 
 /// The mesh as a frame file holds it: a copy of `mesh` made edge-manifold by
 /// tracker::make_edge_manifold() (non-manifold edges, where two sheets meet mid-merge or

@@ -12,11 +12,14 @@
 #include "common/atomic_file.h"
 #include "common/cancellation.h"
 
+#include <tbb/global_control.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -33,8 +36,9 @@ const char* USAGE =
     "usage: meniscus <command> [options]\n"
     "\n"
     "commands:\n"
-    "  run SCENE.json [--out DIR] [--frames N] [--max-steps N] [--quiet]\n"
+    "  run SCENE.json [--out DIR] [--frames N] [--max-steps N] [--quiet] [--threads N]\n"
     "                 [--max-memory GB] [--max-steps-per-frame N]\n"
+    "  run --resume DIR [SCENE.json] [--allow-scene-change] [--frames N] [--threads N]\n"
     "        run a scene, writing per frame surface_NNNN.ply, fields_NNNN.vdb and a line of\n"
     "        stats.jsonl into DIR (default: out/), described by DIR/meniscus.json (units,\n"
     "        frame rate, files); an earlier run's frames in DIR are removed first. --frames N\n"
@@ -46,6 +50,11 @@ const char* USAGE =
     "        Ctrl-C or SIGTERM stops within a second or two (the frame in progress is\n"
     "        discarded; every frame whose stats.jsonl line is written is complete); a second\n"
     "        one ends the program at once.\n"
+    "        Every frame (/output/checkpoint_every) also writes DIR/checkpoint.bin; --resume DIR\n"
+    "        continues the run in DIR from it, writing the same frames an uninterrupted run\n"
+    "        would, byte for byte. The scene is the one the checkpoint names (or SCENE.json); a\n"
+    "        scene changed since is refused unless --allow-scene-change. --threads N (or\n"
+    "        MENISCUS_THREADS) limits the worker threads.\n"
     "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4|A6|B1|...|B7]...\n"
     "           [--xi X]... [--curvature-operator cotangent|quartic_fit]...\n"
     "        run the validation cases — A: the paper's geometric flows (A1–A4; A5 is the cost\n"
@@ -110,9 +119,24 @@ double parse_positive_length(const std::string& flag, const std::string& text) {
     }
 }
 
+/// The worker-thread limit of --threads N, else of MENISCUS_THREADS, else none (TBB's default:
+/// every core). Held for the whole run.
+std::unique_ptr<tbb::global_control> thread_control(int threads) {
+    if (threads <= 0) {
+        const char* env = std::getenv("MENISCUS_THREADS");
+        if (env == nullptr || *env == '\0')
+            return nullptr;
+        threads = parse_positive_int("MENISCUS_THREADS", env);
+    }
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                 static_cast<size_t>(threads));
+}
+
 int command_run(const std::vector<std::string>& args) {
     std::string scene_path;
     RunOptions options;
+    bool allow_scene_change = false, out_given = false;
+    int threads = 0;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         const auto value = [&]() -> const std::string& {
@@ -120,14 +144,22 @@ int command_run(const std::vector<std::string>& args) {
                 throw UsageError(a + ": missing value");
             return args[++i];
         };
-        if (a == "--out")
+        if (a == "--out") {
             options.out_dir = value();
-        else if (a == "--frames")
+            out_given = true;
+        } else if (a == "--frames")
             options.frames = parse_positive_int(a, value());
         else if (a == "--max-steps")
             options.max_steps = parse_positive_int(a, value());
         else if (a == "--quiet")
             options.quiet = true;
+        else if (a == "--resume") {
+            options.out_dir = value();
+            options.resume = true;
+        } else if (a == "--allow-scene-change")
+            allow_scene_change = true;
+        else if (a == "--threads")
+            threads = parse_positive_int(a, value());
         else if (a == "--max-memory")
             options.limits.max_memory_bytes =
                 1e9 * parse_positive_number(a, value(), 1e6, "a memory size in GB, up to 1e6");
@@ -142,10 +174,20 @@ int command_run(const std::vector<std::string>& args) {
             throw UsageError("run: more than one scene file given ('" + scene_path + "', '" + a +
                              "')");
     }
-    if (scene_path.empty())
+    if (options.resume && out_given)
+        throw UsageError("run: --resume DIR continues the run in DIR; --out cannot name another");
+    if (allow_scene_change && !options.resume)
+        throw UsageError("run: --allow-scene-change only applies with --resume DIR");
+    if (scene_path.empty() && !options.resume)
         throw UsageError("run: no scene file given");
+    const auto thread_limit = thread_control(threads);
     install_stop_signal_handlers();
-    const Scene scene = load_scene(scene_path);
+    std::string note;
+    const Scene scene = options.resume
+                            ? scene_for_resume(options.out_dir, scene_path, allow_scene_change, &note)
+                            : load_scene(scene_path);
+    if (!note.empty())
+        std::fprintf(stderr, "meniscus: warning: %s\n", note.c_str());
     const RunResult result = run_scene(scene, options, stop_requested_flag());
     if (result.interrupted) {
         std::fprintf(stderr, "meniscus: interrupted at t = %g s; frames 0..%d in %s are complete\n",

@@ -1,5 +1,6 @@
 #include "app/run.h"
 
+#include "app/checkpoint.h"
 #include "app/frame_output.h"
 #include "app/output_dir.h"
 #include "app/progress.h"
@@ -31,6 +32,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace meniscus::app {
@@ -179,11 +181,23 @@ public:
         return j;
     }
 
+    /// Exact state for checkpoints: the rigid_motion start (nothing for the other exact
+    /// solutions, which are closed forms of t).
+    void save_state(BinaryWriter& out) const {
+        if (m_options.type == "rigid_motion")
+            m_initial.save_state(out);
+    }
+    void load_state(BinaryReader& in) {
+        if (m_options.type == "rigid_motion")
+            m_initial.load_state(in);
+    }
+
 private:
     /// Vertices of the meshed initial shape sit within 1e-3 ξ of it (implicit_mesher).
     static constexpr double INITIAL_VERTEX_TOLERANCE = 1e-2;
     /// Relative volume slack: a polyhedron inscribed in a sphere loses about ℓ²/(4R²).
     static constexpr double INITIAL_VOLUME_TOLERANCE = 0.05;
+
 
     /// rigid_motion: the initial mesh carried by the exact rigid map to time t against the
     /// surface, both ways (tracker::hausdorff_distance): `linf`/`l1` are the surface's distances
@@ -274,6 +288,56 @@ public:
         if (!m_stats)
             throw WriteError(m_stats_path + ": cannot open for writing: " +
                              system_reason(errno, "open failed"));
+    }
+
+    /// A resumed run continues the folder of the run that wrote `checkpoint`: frames after the
+    /// checkpoint's frame (and temporaries) are removed, stats.jsonl is cut back to the lines
+    /// of frames 0 to that frame (the frame's own line restored from the checkpoint when the
+    /// kill came before it was written), and new lines are appended. `checkpoint_bytes`: the
+    /// checkpoint file's size (for a restored line).
+    FrameWriter(const Scene& scene, const RunOptions& options, int frames,
+                const CheckpointHeader& checkpoint, std::uint64_t checkpoint_bytes)
+        : m_scene(scene),
+          m_dir(options.out_dir),
+          m_stats_path((std::filesystem::path(options.out_dir) / STATS_NAME).string()),
+          m_format(frame_format(scene)),
+          m_frames(frames) {
+        const std::vector<std::string> removed = remove_frames_after(m_dir, checkpoint.frame);
+        if (!removed.empty() && !options.quiet)
+            std::fprintf(stderr, "%s: removed %zu files written after the checkpoint (%s ... %s)\n",
+                         m_dir.c_str(), removed.size(), removed.front().c_str(),
+                         removed.back().c_str());
+        std::string kept;
+        {
+            std::ifstream in(m_stats_path, std::ios::binary);
+            std::string line;
+            int lines = 0;
+            while (lines <= checkpoint.frame && std::getline(in, line)) {
+                if (in.eof())
+                    break;  // a last line without its newline was cut short
+                kept += line + '\n';
+                ++lines;
+            }
+            if (lines == checkpoint.frame) {
+                nlohmann::json restored = nlohmann::json::parse(checkpoint.stats_line);
+                restored["seconds"] = nullptr;  // the interrupted run's timings are lost
+                restored["checkpoint"] = {{"bytes", checkpoint_bytes}, {"seconds", nullptr}};
+                kept += restored.dump() + '\n';
+            } else if (lines < checkpoint.frame) {
+                throw InputError(m_stats_path + ": has " + std::to_string(lines) +
+                                 " complete lines, but the checkpoint is at frame " +
+                                 std::to_string(checkpoint.frame) +
+                                 ": the folder does not belong to the checkpoint");
+            }
+        }
+        errno = 0;
+        m_stats.open(m_stats_path, std::ios::binary | std::ios::trunc);
+        m_stats << kept;
+        m_stats.flush();
+        if (!m_stats)
+            throw WriteError(m_stats_path + ": cannot write: " +
+                             system_reason(errno, "write failed"));
+        m_stats_bytes = kept.size();
     }
 
     /// Writes the frame's files; returns seconds spent.
@@ -669,6 +733,103 @@ nlohmann::json fluid_frame_stats(int frame, double time, long long steps,
     return line;
 }
 
+/// Writes the run's checkpoint (app/checkpoint.h) with every /output/checkpoint_every-th frame
+/// and the last, before the frame's stats line, which then records its size and seconds.
+class Checkpointer {
+public:
+    Checkpointer(const Scene& scene, const RunOptions& options, int frames, double nominal_xi)
+        : m_dir(options.out_dir), m_every(scene.output.checkpoint_every), m_frames(frames) {
+        std::error_code ec;
+        const std::filesystem::path absolute = std::filesystem::absolute(scene.source_path, ec);
+        m_header.scene_path = ec ? scene.source_path : absolute.lexically_normal().string();
+        m_header.scene_text = scene.source_text;
+        m_header.flow_type = scene.flow.type;
+        m_header.frames = frames;
+        m_header.nominal_xi = nominal_xi;
+    }
+
+    /// If frame `frame` is due, writes the checkpoint with `save` as its state and the run's
+    /// counters, then adds "checkpoint": {"bytes", "seconds"} to `line` (the frame's stats).
+    template <class SaveState>
+    void write(int frame, double t, const RunResult& result, double last_dt, int stalled_steps,
+               nlohmann::json& line, const SaveState& save) {
+        if (m_every <= 0 || (frame % m_every != 0 && frame != m_frames))
+            return;
+        const auto start = Clock::now();
+        CheckpointHeader h = m_header;
+        h.frame = frame;
+        h.time = t;
+        h.last_dt = last_dt;
+        h.steps = result.steps;
+        h.stalled_steps = stalled_steps;
+        h.max_intersecting_pairs = result.max_intersecting_pairs;
+        // Without its wall-clock timings: they are not the run's state, and with them the
+        // checkpoint's size (reported in stats.jsonl) would vary from run to run.
+        nlohmann::json stored = line;
+        stored.erase("seconds");
+        h.stats_line = stored.dump();
+        BinaryWriter state;
+        save(state);
+        const std::uint64_t bytes = write_checkpoint(m_dir, h, state.bytes());
+        line["checkpoint"] = {{"bytes", bytes}, {"seconds", seconds_since(start)}};
+    }
+
+private:
+    std::string m_dir;
+    int m_every = 1;
+    int m_frames = 0;
+    CheckpointHeader m_header;
+};
+
+/// A resumed run's checkpoint, checked against the run about to continue it.
+struct Resume {
+    Checkpoint checkpoint;
+    std::uint64_t bytes = 0;  ///< the checkpoint file's size
+    int frames = 0;           ///< frames after frame 0 the resumed run ends at
+};
+
+std::optional<Resume> read_resume(const Scene& scene, const RunOptions& options) {
+    if (!options.resume)
+        return std::nullopt;
+    Resume r;
+    r.checkpoint = read_checkpoint(options.out_dir);
+    const CheckpointHeader& h = r.checkpoint.header;
+    const std::string path = (std::filesystem::path(options.out_dir) / CHECKPOINT_NAME).string();
+    std::error_code ec;
+    r.bytes = std::filesystem::file_size(path, ec);
+    if (h.flow_type != scene.flow.type)
+        throw InputError(path + ": written by a /flow/type \"" + h.flow_type +
+                         "\" run, the scene's is \"" + scene.flow.type + "\"");
+    r.frames = options.frames > 0 ? options.frames : h.frames;
+    if (r.frames < h.frame)
+        throw InputError("--frames " + std::to_string(options.frames) +
+                         ": the checkpoint in " + options.out_dir + " is already at frame " +
+                         std::to_string(h.frame));
+    return r;
+}
+
+/// Restores a solver from a checkpoint's state block; a state that does not fit (a scene
+/// changed under --allow-scene-change, a damaged file) is bad input naming the file.
+template <class Restore>
+void restore_state(const Resume& resume, const RunOptions& options, const Restore& restore) {
+    try {
+        BinaryReader in(resume.checkpoint.state.data(), resume.checkpoint.state.size());
+        restore(in);
+        if (!in.at_end())
+            throw FormatError("bytes left after the state");
+    } catch (const FormatError& e) {
+        throw InputError((std::filesystem::path(options.out_dir) / CHECKPOINT_NAME).string() +
+                         ": its state does not fit this scene: " + e.what());
+    }
+}
+
+/// A stand-in surface for solvers that a checkpoint's state then replaces (a resumed run does
+/// not mesh its initial shape again).
+SurfaceMesh placeholder_surface() {
+    return SurfaceMesh({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)},
+                       {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}});
+}
+
 /// The coupled simulation of a fluid scene from its initial surface.
 static coupling::Simulation fluid_simulation(const Scene& scene, SurfaceMesh initial,
                                              double nominal_xi) {
@@ -703,33 +864,67 @@ coupling::Simulation make_fluid_simulation(const Scene& scene, std::string* repo
 /// exception still knows what was written).
 static void run_fluid_scene(const Scene& scene, const RunOptions& options,
                             const std::atomic<bool>& stop, RunResult& result) {
+    const std::optional<Resume> resume = read_resume(scene, options);
     std::string report;
     double nominal_xi = 0.0;
-    SurfaceMesh initial = checked_initial_surface(scene, options, &report, &nominal_xi);
-    coupling::Simulation sim = fluid_simulation(scene, std::move(initial), nominal_xi);
+    std::optional<coupling::Simulation> simulation;
+    if (resume) {
+        prepare_output_dir(options.out_dir);
+        nominal_xi = resume->checkpoint.header.nominal_xi;
+        simulation.emplace(fluid_simulation(scene, placeholder_surface(), nominal_xi));
+        restore_state(*resume, options, [&](BinaryReader& in) { simulation->load_state(in); });
+        report = "resumed at frame " + std::to_string(resume->checkpoint.header.frame) +
+                 " from " + options.out_dir + "/" + CHECKPOINT_NAME;
+    } else {
+        SurfaceMesh initial = checked_initial_surface(scene, options, &report, &nominal_xi);
+        simulation.emplace(fluid_simulation(scene, std::move(initial), nominal_xi));
+    }
+    coupling::Simulation& sim = *simulation;
     const double dx = sim.fluid().grid().dx();
     if (!options.quiet)
         std::fprintf(stderr, "%s: %s; fluid grid %d x %d x %d, dx = %g m\n", scene.name.c_str(),
                      report.c_str(), sim.fluid().grid().nx(), sim.fluid().grid().ny(),
                      sim.fluid().grid().nz(), dx);
 
-    const int frames = options.frames > 0 ? options.frames : scene.time.frames;
+    const int frames =
+        resume ? resume->frames : options.frames > 0 ? options.frames : scene.time.frames;
     const double frame_dt = scene.time.end / scene.time.frames;
     const double end_time = frame_dt * frames;
-    FrameWriter writer(scene, options, frames);
+    std::optional<FrameWriter> frame_writer;
+    if (resume)
+        frame_writer.emplace(scene, options, frames, resume->checkpoint.header, resume->bytes);
+    else
+        frame_writer.emplace(scene, options, frames);
+    FrameWriter& writer = *frame_writer;
+    Checkpointer checkpointer(scene, options, frames, nominal_xi);
+    const auto save = [&](BinaryWriter& out) { sim.save_state(out); };
     Progress progress(stderr, options.quiet);
     const auto fields = [&]() {
         return coupling::FluidFields{&sim.fluid().grid(), &sim.fluid().pressure()};
     };
 
     coupling::SimulationStepReport last;
-    double output_seconds =
-        writer.write(0, sim.tracker().mesh(), sim.vertex_velocities(), fields());
-    writer.stats(fluid_frame_stats(0, 0.0, 0, sim, last, {{"output", output_seconds}},
-                                   nlohmann::json::object()));
-    result.frames_written = 1;
     double t = 0.0;
-    for (int frame = 1; frame <= frames; ++frame) {
+    int first_frame = 1;
+    if (resume) {
+        const CheckpointHeader& h = resume->checkpoint.header;
+        t = h.time;
+        first_frame = h.frame + 1;
+        result.steps = h.steps;
+        result.max_intersecting_pairs = h.max_intersecting_pairs;
+        result.simulated_time = t;
+        result.frames_written = h.frame + 1;
+    } else {
+        const double output_seconds =
+            writer.write(0, sim.tracker().mesh(), sim.vertex_velocities(), fields());
+        nlohmann::json line = fluid_frame_stats(0, 0.0, 0, sim, last,
+                                                {{"output", output_seconds}},
+                                                nlohmann::json::object());
+        checkpointer.write(0, 0.0, result, 0.0, 0, line, save);
+        writer.stats(line);
+        result.frames_written = 1;
+    }
+    for (int frame = first_frame; frame <= frames; ++frame) {
         const double t_frame = frame == frames ? end_time : frame * frame_dt;
         long long steps = 0;
         double rasterize = 0.0, fluid_s = 0.0, interpolate = 0.0, tracker_s = 0.0;
@@ -754,19 +949,21 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
             ++steps;
             ++result.steps;
         }
-        output_seconds =
+        const double output_seconds =
             writer.write(frame, sim.tracker().mesh(), sim.vertex_velocities(), fields());
-        writer.stats(fluid_frame_stats(frame, t, steps, sim, last,
-                                       {{"rasterize", rasterize},
-                                        {"fluid", fluid_s},
-                                        {"interpolate", interpolate},
-                                        {"tracker", tracker_s},
-                                        {"output", output_seconds}},
-                                       {{"intersecting_pairs", intersecting},
-                                        {"merges", merges},
-                                        {"splits", splits},
-                                        {"step_shortenings", shortenings},
-                                        {"solves", solves.json(steps)}}));
+        nlohmann::json line = fluid_frame_stats(frame, t, steps, sim, last,
+                                                {{"rasterize", rasterize},
+                                                 {"fluid", fluid_s},
+                                                 {"interpolate", interpolate},
+                                                 {"tracker", tracker_s},
+                                                 {"output", output_seconds}},
+                                                {{"intersecting_pairs", intersecting},
+                                                 {"merges", merges},
+                                                 {"splits", splits},
+                                                 {"step_shortenings", shortenings},
+                                                 {"solves", solves.json(steps)}});
+        checkpointer.write(frame, t, result, 0.0, 0, line, save);
+        writer.stats(line);
         const std::string warning = solves.warning(frame, steps);
         if (!warning.empty() && !options.quiet) {
             progress.finish();
@@ -786,7 +983,9 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
 /// Runs a geometric-flow scene; see run_fluid_scene().
 static void run_geometric_scene(const Scene& scene, const RunOptions& options,
                                 const std::atomic<bool>& stop, RunResult& result) {
-    const int frames = options.frames > 0 ? options.frames : scene.time.frames;
+    const std::optional<Resume> resume = read_resume(scene, options);
+    const int frames =
+        resume ? resume->frames : options.frames > 0 ? options.frames : scene.time.frames;
     // --frames keeps the time per frame of the scene.
     const double frame_dt = scene.time.end / scene.time.frames;
     const double end_time = frame_dt * frames;
@@ -796,36 +995,72 @@ static void run_geometric_scene(const Scene& scene, const RunOptions& options,
 
     std::string report;
     double nominal_xi = 0.0;
-    SurfaceMesh initial = checked_initial_surface(scene, options, &report, &nominal_xi);
-    tracker::SurfaceTracker tracker(std::move(initial), tracker_options(scene, nominal_xi));
+    std::optional<tracker::SurfaceTracker> surface_tracker;
+    if (resume) {
+        prepare_output_dir(options.out_dir);
+        nominal_xi = resume->checkpoint.header.nominal_xi;
+        surface_tracker.emplace(placeholder_surface(), tracker_options(scene, nominal_xi));
+        restore_state(*resume, options, [&](BinaryReader& in) {
+            surface_tracker->load_state(in);
+            exact.load_state(in);
+        });
+        report = "resumed at frame " + std::to_string(resume->checkpoint.header.frame) +
+                 " from " + options.out_dir + "/" + CHECKPOINT_NAME;
+    } else {
+        SurfaceMesh initial = checked_initial_surface(scene, options, &report, &nominal_xi);
+        surface_tracker.emplace(std::move(initial), tracker_options(scene, nominal_xi));
+    }
+    tracker::SurfaceTracker& tracker = *surface_tracker;
     const SurfaceMesh& mesh = tracker.mesh();
     if (!options.quiet)
         std::fprintf(stderr, "%s: %s\n", scene.name.c_str(), report.c_str());
-    if (exact.enabled())
+    if (exact.enabled() && !resume)
         exact.check_initial(mesh, tracker.characteristic_length());
     for (const std::string& warning : plausibility_warnings(scene, tracker.characteristic_length()))
         std::fprintf(stderr, "meniscus: warning: %s\n", warning.c_str());
     const GeometricFlow flow = make_flow(scene.flow, scene.cancel);
 
-    FrameWriter writer(scene, options, frames);
+    std::optional<FrameWriter> frame_writer;
+    if (resume)
+        frame_writer.emplace(scene, options, frames, resume->checkpoint.header, resume->bytes);
+    else
+        frame_writer.emplace(scene, options, frames);
+    FrameWriter& writer = *frame_writer;
+    Checkpointer checkpointer(scene, options, frames, nominal_xi);
     Progress progress(stderr, options.quiet);
     std::vector<Vec3> velocities(static_cast<size_t>(mesh.num_vertices()), Vec3::Zero());
-    const auto write_stats = [&](int frame, double t, double dt, long long steps,
+    double t = 0.0, dt = 0.0;
+    int stalled = 0;
+    const auto write_stats = [&](int frame, double time, double step_dt, long long steps,
                                  const FrameWork& work) {
-        nlohmann::json line = frame_stats(frame, t, dt, steps, mesh, work);
+        nlohmann::json line = frame_stats(frame, time, step_dt, steps, mesh, work);
         if (exact.enabled())
-            line["exact_error"] = exact.stats(mesh, t);
+            line["exact_error"] = exact.stats(mesh, time);
+        checkpointer.write(frame, time, result, step_dt, stalled, line, [&](BinaryWriter& out) {
+            tracker.save_state(out);
+            exact.save_state(out);
+        });
         writer.stats(line);
     };
 
     FrameWork work;
-    work.output = writer.write(0, mesh, velocities);
-    write_stats(0, 0.0, 0.0, 0, work);
-    result.frames_written = 1;
-
-    double t = 0.0, dt = 0.0;
-    int stalled = 0;
-    for (int frame = 1; frame <= frames; ++frame) {
+    int first_frame = 1;
+    if (resume) {
+        const CheckpointHeader& h = resume->checkpoint.header;
+        t = h.time;
+        dt = h.last_dt;
+        stalled = h.stalled_steps;
+        first_frame = h.frame + 1;
+        result.steps = h.steps;
+        result.max_intersecting_pairs = h.max_intersecting_pairs;
+        result.simulated_time = t;
+        result.frames_written = h.frame + 1;
+    } else {
+        work.output = writer.write(0, mesh, velocities);
+        write_stats(0, 0.0, 0.0, 0, work);
+        result.frames_written = 1;
+    }
+    for (int frame = first_frame; frame <= frames; ++frame) {
         const double t_frame = frame == frames ? end_time : frame * frame_dt;
         long long steps = 0;
         work = FrameWork{};
@@ -925,6 +1160,36 @@ RunResult run_scene(const Scene& scene, const RunOptions& options, const std::at
                                        std::to_string(result.frames_written) + ")");
     }
     return result;
+}
+
+Scene scene_for_resume(const std::string& dir, const std::string& scene_path, bool allow_change,
+                       std::string* note) {
+    const Checkpoint checkpoint = read_checkpoint(dir);
+    const CheckpointHeader& h = checkpoint.header;
+    const std::string path = scene_path.empty() ? h.scene_path : scene_path;
+    std::error_code ec;
+    if (scene_path.empty() && !std::filesystem::exists(path, ec)) {
+        if (note)
+            *note = path + " no longer exists: resuming with the scene text saved in the checkpoint";
+        const std::filesystem::path p(path);
+        return parse_scene(h.scene_text, path, p.has_parent_path() ? p.parent_path().string() : ".");
+    }
+    Scene scene = load_scene(path);
+    const std::vector<std::string> changed = scene_differences(h.scene_text, scene.source_text);
+    if (changed.empty())
+        return scene;
+    std::string list;
+    for (const std::string& c : changed)
+        list += (list.empty() ? "" : ", ") + c;
+    if (!allow_change)
+        throw InputError(path + ": changed since the checkpoint in " + dir + " was written (" +
+                         list + "); resume with the scene as it was, or pass --allow-scene-change "
+                         "to continue with the changed scene (the frames then differ from an "
+                         "uninterrupted run)");
+    if (note)
+        *note = path + " changed since the checkpoint (" + list +
+                "); continuing with the changed scene (--allow-scene-change)";
+    return scene;
 }
 
 }  // namespace meniscus::app

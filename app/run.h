@@ -31,7 +31,17 @@ struct RunOptions {
     long long max_steps = 0;  ///< > 0 stops after this many steps (smoke tests)
     bool quiet = false;
     ResourceLimits limits;  ///< estimated memory and steps per frame allowed before starting
+    /// Continue the run in out_dir from its checkpoint (app/checkpoint.h) instead of starting:
+    /// the scene must be the one the checkpoint holds (scene_for_resume()).
+    bool resume = false;
 };
+
+/// The scene of `meniscus run --resume DIR [SCENE]`: SCENE, or the scene file the checkpoint in
+/// DIR names. Throws InputError when the file's JSON differs from the text the checkpoint holds
+/// (naming the JSON paths that changed) unless `allow_change`; when the file no longer exists
+/// (and no SCENE is given) the checkpoint's copy is used and `note` says so.
+Scene scene_for_resume(const std::string& dir, const std::string& scene_path, bool allow_change,
+                       std::string* note);
 
 /// How a run ended.
 struct RunResult {

@@ -352,6 +352,9 @@ void visit_fields(V& v, OutputOptions& o) {
     v.choice("length_unit", o.length_unit, {"m", "cm", "mm"},
              "unit of every length written: PLY/OBJ positions and velocities (unit/s), VDB "
              "transforms, distances and `vel`; recorded in meniscus.json (stats.jsonl stays SI)");
+    v.integer("checkpoint_every", o.checkpoint_every, Range::between(0, 1000000), "frames",
+              "write checkpoint.bin (everything `meniscus run --resume` needs to continue the run "
+              "exactly) with every Nth frame and the last; 0 = never");
 }
 
 template <typename V>
@@ -747,6 +750,7 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
         }
         Scene scene;
         scene.source_path = source;
+        scene.source_text = json_text;
         JsonReader root(j, "");
         visit_fields(root, scene);
         // /surface/shape is a tree, parsed separately.

@@ -127,6 +127,9 @@ struct OutputOptions {
     /// distances): "m", "cm" or "mm". Millimetres by default: Blender's Cycles renders the
     /// shipped fluid scenes' ~0.1 mm voxels only when they are not ~1e-4 units small.
     std::string length_unit = "mm";
+    /// Write the run's checkpoint (checkpoint.bin, for `meniscus run --resume`) with every Nth
+    /// frame and the last; 0 = never.
+    int checkpoint_every = 1;
 };
 
 /// A whole scene.
@@ -144,6 +147,7 @@ struct Scene {
     TimeOptions time;
     OutputOptions output;
     std::string source_path;  ///< the file it was read from
+    std::string source_text;  ///< its text (a checkpoint keeps it; a resume compares it)
     /// Stops meshing and stepping (set by run_scene() from its stop flag; never by the file).
     CancellationToken cancel;
 };

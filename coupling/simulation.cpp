@@ -194,4 +194,44 @@ double Simulation::kinetic_energy() const {
     return energy;
 }
 
+void Simulation::save_state(BinaryWriter& out) const {
+    out.put(m_time);
+    m_tracker->save_state(out);
+    m_fluid.save_state(out);
+    out.put<std::uint8_t>(m_volumes ? 1 : 0);
+    if (m_volumes)
+        m_volumes->save_state(out);
+    out.put_vector(m_vertex_velocities);
+    out.put<std::uint8_t>(m_phi.size() > 0 ? 1 : 0);
+    if (m_phi.size() > 0)
+        fluid::save_array(out, m_phi);
+}
+
+void Simulation::load_state(BinaryReader& in) {
+    const double time = in.get<double>();
+    if (!std::isfinite(time) || time < 0.0)
+        throw FormatError("simulation state: the time is not a number >= 0");
+    m_tracker->load_state(in);
+    m_fluid.load_state(in);
+    const std::uint8_t has_volumes = in.get<std::uint8_t>();
+    if (has_volumes != (m_volumes ? 1 : 0))
+        throw FormatError("simulation state: volume correction was " +
+                          std::string(has_volumes ? "on" : "off") + " when it was saved");
+    if (m_volumes)
+        m_volumes->load_state(in);
+    std::vector<tracker::Vec3> velocities = in.get_vector<tracker::Vec3>();
+    if (velocities.size() != static_cast<size_t>(m_tracker->mesh().num_vertices()))
+        throw FormatError("simulation state: the vertex velocities do not match the mesh");
+    const std::uint8_t has_phi = in.get<std::uint8_t>();
+    fluid::Array3<double> phi;
+    if (has_phi) {
+        const fluid::MacGrid& g = m_fluid.grid();
+        phi.resize(g.nx(), g.ny(), g.nz());
+        fluid::load_array(in, phi, "simulation state: phi");
+    }
+    m_vertex_velocities = std::move(velocities);
+    m_phi = std::move(phi);
+    m_time = time;
+}
+
 }  // namespace meniscus::coupling

@@ -74,6 +74,13 @@ public:
     /// Kinetic energy ½ Σ ρ u² dV over the grid's faces (J), liquid and gas by φ.
     double kinetic_energy() const;
 
+    /// Exact state for checkpoints: time, tracker, fluid, volume targets, the last vertex
+    /// velocities and φ; a Simulation built from the same scene and given this state steps
+    /// exactly as this one would. load_state() throws FormatError on truncated or mismatched
+    /// data (then the simulation must not be stepped).
+    void save_state(BinaryWriter& out) const;
+    void load_state(BinaryReader& in);
+
 private:
     /// Adds the sub-grid surface-tension velocity (subgrid_tension_velocities(), rate from
     /// options.surface_tension) to `velocities`, each capped at a quarter edge per `dt`.

@@ -1,6 +1,7 @@
 #include "coupling/vdb_output.h"
 
 #include "common/atomic_file.h"
+#include "common/binary_io.h"
 #include "coupling/mesh_band.h"
 
 #include <openvdb/openvdb.h>
@@ -10,7 +11,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -319,8 +322,41 @@ openvdb::FloatGrid::Ptr density_grid(const openvdb::FloatGrid& surface,
 /// with grid offsets, which readers such as Blender need).
 class CheckedArchive final : public openvdb::io::Archive {
 public:
-    void write_seekable(std::ostream& out, const openvdb::GridPtrVec& grids) const {
+    /// The file's bytes, with the UUID made from its content (content_uuid).
+    std::string write_seekable(const openvdb::GridPtrVec& grids) const {
+        std::ostringstream out(std::ios::binary);
         openvdb::io::Archive::write(out, grids, /*seekable=*/true);
+        std::string bytes = std::move(out).str();
+        content_uuid(bytes, getUniqueTag());
+        return bytes;
+    }
+
+private:
+    /// OpenVDB stamps every file with a random UUID (Archive::writeHeader), so two runs of one
+    /// scene, or a run and its resumed copy, wrote different bytes. Readers use the UUID only to
+    /// tell files apart (caches); here it is a hash of the file's other bytes, as an RFC 9562
+    /// version-8 ("custom") UUID: the same content gets the same UUID, different content a
+    /// different one (up to 64-bit hash collisions).
+    static void content_uuid(std::string& bytes, const std::string& written) {
+        constexpr std::size_t HEADER_BYTES = 64;  // magic, versions, offsets flag, then the UUID
+        const std::size_t at = bytes.find(written);
+        if (written.size() != 36 || at == std::string::npos || at > HEADER_BYTES)
+            throw std::logic_error("write_surface_vdb: the archive's UUID is not in its header");
+        std::fill_n(bytes.begin() + static_cast<std::ptrdiff_t>(at), written.size(), '0');
+        const std::uint64_t hi = fnv1a64(bytes.data(), bytes.size());
+        std::uint64_t lo = hi ^ (0x9e3779b97f4a7c15ull + bytes.size());  // splitmix64 finaliser
+        lo = (lo ^ (lo >> 30)) * 0xbf58476d1ce4e5b9ull;
+        lo = (lo ^ (lo >> 27)) * 0x94d049bb133111ebull;
+        lo ^= lo >> 31;
+        char hex[33];
+        std::snprintf(hex, sizeof hex, "%016llx%016llx", static_cast<unsigned long long>(hi),
+                      static_cast<unsigned long long>(lo));
+        hex[12] = '8';                                         // version 8
+        hex[16] = "89ab"[(hex[16] <= '9' ? hex[16] - '0' : hex[16] - 'a' + 10) & 3];  // variant
+        const std::string uuid = std::string(hex, 8) + '-' + std::string(hex + 8, 4) + '-' +
+                                 std::string(hex + 12, 4) + '-' + std::string(hex + 16, 4) + '-' +
+                                 std::string(hex + 20, 12);
+        bytes.replace(at, uuid.size(), uuid);
     }
 };
 
@@ -359,14 +395,14 @@ VdbOutputInfo write_surface_vdb(const std::string& path, const tracker::SurfaceM
     if (fluid.grid)
         append_fluid_grids(fluid, options, grids, info);
 
-    std::ofstream out = open_temporary(path, std::ios::binary);
+    std::string bytes;
     try {
-        CheckedArchive().write_seekable(out, grids);
+        bytes = CheckedArchive().write_seekable(grids);
     } catch (const openvdb::Exception& e) {
-        out.close();
-        std::remove(temporary_path_for(path).c_str());
         throw WriteError(path + ": cannot write VDB: " + e.what());
     }
+    std::ofstream out = open_temporary(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     commit_stream(out, path);
     return info;
 }

@@ -175,4 +175,30 @@ double VolumeTracker::add_correction(std::vector<Vec3>& velocities, double dt) c
     return largest;
 }
 
+void VolumeTracker::save_state(BinaryWriter& out) const {
+    out.put_vector(m_vertex_component);
+    out.put_vector(m_old_targets);
+    out.put_vector(m_targets);
+    out.put_vector(m_triangle_component);
+}
+
+void VolumeTracker::load_state(BinaryReader& in) {
+    std::vector<int> vertex_component = in.get_vector<int>();
+    std::vector<double> old_targets = in.get_vector<double>();
+    std::vector<double> targets = in.get_vector<double>();
+    std::vector<int> triangle_component = in.get_vector<int>();
+    const auto in_range = [](const std::vector<int>& components, size_t count) {
+        return std::all_of(components.begin(), components.end(), [&](int c) {
+            return c >= -1 && c < static_cast<int>(count);
+        });
+    };
+    if (!in_range(vertex_component, std::max(old_targets.size(), targets.size())) ||
+        !in_range(triangle_component, std::max(old_targets.size(), targets.size())))
+        throw FormatError("volume state: a component index is out of range");
+    m_vertex_component = std::move(vertex_component);
+    m_old_targets = std::move(old_targets);
+    m_targets = std::move(targets);
+    m_triangle_component = std::move(triangle_component);
+}
+
 }  // namespace meniscus::coupling

@@ -58,6 +58,11 @@ public:
 
     void on_compact(const std::vector<int>& old_to_new_vertex) override;
 
+    /// Exact state for checkpoints (targets and component maps); load_state() throws
+    /// FormatError on truncated data.
+    void save_state(BinaryWriter& out) const;
+    void load_state(BinaryReader& in);
+
 private:
     tracker::SurfaceMesh& m_mesh;
     std::vector<int> m_vertex_component;  ///< old component per vertex (−1 unknown)

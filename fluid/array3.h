@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "common/assert.h"
+#include "common/binary_io.h"
 
 namespace meniscus::fluid {
 
@@ -78,5 +80,29 @@ private:
     int m_nk = 0;
     std::vector<T> m_data;
 };
+
+/// Writes the array's extents and values (checkpoints).
+template <class T>
+void save_array(BinaryWriter& out, const Array3<T>& a) {
+    out.put(a.ni());
+    out.put(a.nj());
+    out.put(a.nk());
+    out.put_vector(a.storage());
+}
+
+/// Reads what save_array() wrote into `a`, whose extents it must have (the reader's grid is
+/// built from the same scene); throws FormatError naming `what` otherwise or if data is missing.
+template <class T>
+void load_array(BinaryReader& in, Array3<T>& a, const char* what) {
+    const int ni = in.get<int>(), nj = in.get<int>(), nk = in.get<int>();
+    std::vector<T> values = in.get_vector<T>();
+    if (ni != a.ni() || nj != a.nj() || nk != a.nk() ||
+        values.size() != static_cast<std::size_t>(a.size()))
+        throw FormatError(std::string(what) + ": the saved array is " + std::to_string(ni) + " x " +
+                          std::to_string(nj) + " x " + std::to_string(nk) + ", the grid's " +
+                          std::to_string(a.ni()) + " x " + std::to_string(a.nj()) + " x " +
+                          std::to_string(a.nk()));
+    a.storage() = std::move(values);
+}
 
 }  // namespace meniscus::fluid

@@ -1,6 +1,8 @@
 #include "fluid/fluid_solver.h"
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <chrono>
 #include <stdexcept>
 
@@ -274,6 +276,41 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
 
 TimeStepLimits FluidSolver::time_step_limits() const {
     return compute_time_step(m_grid, m_options.phases, m_options.mode, m_options.time_step);
+}
+
+void FluidSolver::save_state(BinaryWriter& out) const {
+    for (int axis = 0; axis < 3; ++axis)
+        save_array(out, m_grid.velocity(axis));
+    save_array(out, m_pressure);
+    out.put<std::uint8_t>(m_increment.size() > 0 ? 1 : 0);
+    if (m_increment.size() > 0)
+        save_array(out, m_increment);
+    out.put_vector(m_was_liquid);
+}
+
+void FluidSolver::load_state(BinaryReader& in) {
+    std::array<Array3<double>, 3> velocity{m_grid.u(), m_grid.v(), m_grid.w()};
+    const char* names[] = {"fluid state: u", "fluid state: v", "fluid state: w"};
+    for (int axis = 0; axis < 3; ++axis)
+        load_array(in, velocity[static_cast<size_t>(axis)], names[axis]);
+    Array3<double> pressure = m_pressure;
+    load_array(in, pressure, "fluid state: pressure");
+    Array3<double> increment;
+    const std::uint8_t has_increment = in.get<std::uint8_t>();
+    if (has_increment > 1)
+        throw FormatError("fluid state: bad increment flag");
+    if (has_increment) {
+        increment = m_pressure;
+        load_array(in, increment, "fluid state: pressure increment");
+    }
+    std::vector<char> was_liquid = in.get_vector<char>();
+    if (!was_liquid.empty() && was_liquid.size() != m_pressure.size())
+        throw FormatError("fluid state: the liquid flags do not match the grid");
+    for (int axis = 0; axis < 3; ++axis)
+        m_grid.velocity(axis) = std::move(velocity[static_cast<size_t>(axis)]);
+    m_pressure = std::move(pressure);
+    m_increment = std::move(increment);
+    m_was_liquid = std::move(was_liquid);
 }
 
 }  // namespace meniscus::fluid

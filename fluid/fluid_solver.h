@@ -91,6 +91,12 @@ public:
     const Array3<double>& pressure() const { return m_pressure; }
     const FluidOptions& options() const { return m_options; }
 
+    /// Exact state for checkpoints: the face velocities, the pressure the next step starts
+    /// from, its increment and the last step's liquid cells. load_state() needs a solver built
+    /// with the same grid and options and throws FormatError on truncated or mismatched data.
+    void save_state(BinaryWriter& out) const;
+    void load_state(BinaryReader& in);
+
 private:
     /// Viscosity, gravity and projection of the split scheme.
     void split_step(double dt, const InterfaceInput& interface, StepResult& result);

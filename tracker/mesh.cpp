@@ -3,6 +3,7 @@
 #include "common/assert.h"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -382,6 +383,86 @@ void SurfaceMesh::add_observer(MeshObserver* observer) {
 void SurfaceMesh::remove_observer(MeshObserver* observer) {
     m_observers.erase(std::remove(m_observers.begin(), m_observers.end(), observer),
                       m_observers.end());
+}
+
+// ---- exact state ----------------------------------------------------------------------------
+
+namespace {
+
+/// Throws FormatError unless every index of `lists` is in [0, limit).
+void check_index_lists(const std::vector<std::vector<int>>& lists, int limit, const char* what) {
+    for (const std::vector<int>& list : lists)
+        for (int i : list)
+            if (i < 0 || i >= limit)
+                throw FormatError(std::string("mesh state: ") + what + " names element " +
+                                  std::to_string(i) + " of " + std::to_string(limit));
+}
+
+/// Throws FormatError unless each entry is all −1 (dead) or all in [0, limit).
+template <size_t N>
+void check_index_tuples(const std::vector<std::array<int, N>>& tuples, int limit,
+                        const char* what) {
+    for (const std::array<int, N>& t : tuples) {
+        const bool dead = t[0] < 0;
+        for (int i : t)
+            if (dead ? i != -1 : (i < 0 || i >= limit))
+                throw FormatError(std::string("mesh state: ") + what + " names element " +
+                                  std::to_string(i) + " of " + std::to_string(limit));
+    }
+}
+
+}  // namespace
+
+void SurfaceMesh::save_state(BinaryWriter& out) const {
+    out.put_vector(m_positions);
+    out.put_vector(m_vertex_alive);
+    out.put_vector(m_triangles);
+    out.put_vector(m_labels);
+    out.put_vector(m_triangle_edges);
+    out.put_vector(m_edges);
+    out.put_nested(m_edge_triangles);
+    out.put_nested(m_vertex_triangles);
+    out.put_nested(m_vertex_edges);
+}
+
+void SurfaceMesh::load_state(BinaryReader& in) {
+    SurfaceMesh m;
+    m.m_positions = in.get_vector<Vec3>();
+    m.m_vertex_alive = in.get_vector<std::uint8_t>();
+    m.m_triangles = in.get_vector<Triangle>();
+    m.m_labels = in.get_vector<LabelPair>();
+    m.m_triangle_edges = in.get_vector<std::array<int, 3>>();
+    m.m_edges = in.get_vector<Edge>();
+    m.m_edge_triangles = in.get_nested<int>();
+    m.m_vertex_triangles = in.get_nested<int>();
+    m.m_vertex_edges = in.get_nested<int>();
+    const size_t nv = m.m_positions.size(), nt = m.m_triangles.size(), ne = m.m_edges.size();
+    if (m.m_vertex_alive.size() != nv || m.m_vertex_triangles.size() != nv ||
+        m.m_vertex_edges.size() != nv || m.m_labels.size() != nt ||
+        m.m_triangle_edges.size() != nt || m.m_edge_triangles.size() != ne ||
+        nv > static_cast<size_t>(std::numeric_limits<int>::max()) ||
+        nt > static_cast<size_t>(std::numeric_limits<int>::max()) ||
+        ne > static_cast<size_t>(std::numeric_limits<int>::max()))
+        throw FormatError("mesh state: array sizes disagree");
+    for (std::uint8_t alive : m.m_vertex_alive)
+        if (alive > 1)
+            throw FormatError("mesh state: a vertex flag is neither 0 nor 1");
+    for (const Vec3& p : m.m_positions)
+        if (!p.allFinite())
+            throw FormatError("mesh state: a vertex position is not finite");
+    check_index_tuples(m.m_triangles, static_cast<int>(nv), "a triangle");
+    for (size_t t = 0; t < nt; ++t)
+        if (m.m_triangles[t][0] >= 0)
+            for (int e : m.m_triangle_edges[t])
+                if (e < 0 || e >= static_cast<int>(ne))
+                    throw FormatError("mesh state: a triangle's edge names element " +
+                                      std::to_string(e) + " of " + std::to_string(ne));
+    check_index_tuples(m.m_edges, static_cast<int>(nv), "an edge");
+    check_index_lists(m.m_edge_triangles, static_cast<int>(nt), "an edge's triangle list");
+    check_index_lists(m.m_vertex_triangles, static_cast<int>(nt), "a vertex's triangle list");
+    check_index_lists(m.m_vertex_edges, static_cast<int>(ne), "a vertex's edge list");
+    m.m_observers = std::move(m_observers);
+    *this = std::move(m);
 }
 
 }  // namespace meniscus::tracker

@@ -13,6 +13,8 @@
 /// it in each direction (consistent orientation); on open surfaces (§4.4) boundary edges have
 /// exactly one triangle.
 
+#include "common/binary_io.h"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -166,6 +168,16 @@ public:
     /// Removes dead slots and renumbers vertices, triangles and edges, preserving the order of
     /// live elements. Observers receive the vertex map. Returns the vertex map.
     std::vector<int> compact();
+
+    // ---- exact state (checkpoints) ---------------------------------------------------------
+    /// Writes every array, dead slots and adjacency order included, so that load_state()
+    /// rebuilds a mesh on which every later operation does exactly what it would have done here.
+    void save_state(BinaryWriter& out) const;
+    /// Replaces this mesh's contents by a state save_state() wrote, keeping its observers (they
+    /// are not told: the caller restores their state too). Throws FormatError if the data is
+    /// truncated or inconsistent (sizes that disagree, an index out of range), leaving the mesh
+    /// unchanged.
+    void load_state(BinaryReader& in);
 
     // ---- observers ---------------------------------------------------------------------
     /// Registers an observer (not owned; must outlive its registration).

@@ -103,4 +103,18 @@ IntegrateResult SurfaceTracker::integrate(const std::vector<Vec3>& velocities, d
     return result;
 }
 
+void SurfaceTracker::save_state(BinaryWriter& out) const {
+    out.put(m_xi);
+    m_mesh.save_state(out);
+}
+
+void SurfaceTracker::load_state(BinaryReader& in) {
+    const double xi = in.get<double>();
+    if (!(xi > 0.0) || !std::isfinite(xi))
+        throw FormatError("tracker state: the characteristic length is not a positive number");
+    m_mesh.load_state(in);
+    m_xi = xi;
+    m_options.collision.proximity_epsilon = m_options.proximity_fraction * m_xi;  // as built
+}
+
 }  // namespace meniscus::tracker

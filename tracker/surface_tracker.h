@@ -74,6 +74,12 @@ public:
     /// on. Throws std::invalid_argument on size mismatch or dt ≤ 0.
     IntegrateResult integrate(const std::vector<Vec3>& velocities, double dt);
 
+    /// Exact state for checkpoints: ξ and the mesh (SurfaceMesh::save_state). The options are
+    /// the caller's (a resumed run builds the tracker from the same scene). load_state() throws
+    /// FormatError on truncated or inconsistent data.
+    void save_state(BinaryWriter& out) const;
+    void load_state(BinaryReader& in);
+
 private:
     SurfaceMesh m_mesh;
     TrackerOptions m_options;
