@@ -131,8 +131,7 @@ Checkpoint read_checkpoint(const std::string& dir) {
         c.state = in.get_string();
         if (!in.at_end())
             throw corrupt("bytes after the state");
-        if (h.frame < 0 || h.frames < 1 || h.frame > h.frames || !(h.time >= 0.0) ||
-            h.steps < 0)
+        if (h.frame < 0 || h.frames < 1 || h.frame > h.frames || !(h.time >= 0.0) || h.steps < 0)
             throw corrupt("its counters are out of range");
     } catch (const FormatError& e) {
         throw corrupt(e.what());

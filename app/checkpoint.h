@@ -24,18 +24,18 @@ constexpr std::uint32_t CHECKPOINT_VERSION = 1;
 
 /// What the run records beside the solver state.
 struct CheckpointHeader {
-    std::string scene_path;     ///< the scene file as given to `meniscus run`, made absolute
-    std::string scene_text;     ///< its text when the run started
-    std::string flow_type;      ///< /flow/type ("fluid" or a geometric flow)
-    int frame = 0;              ///< the frame this checkpoint was written with
-    int frames = 0;             ///< frames the run writes after frame 0 (--frames or the scene)
-    double time = 0.0;          ///< simulated time at `frame` (s)
-    double last_dt = 0.0;       ///< geometric flows: the last step's dt (for stats)
-    long long steps = 0;        ///< steps taken so far
-    int stalled_steps = 0;      ///< geometric flows: consecutive steps that advanced no time
+    std::string scene_path;  ///< the scene file as given to `meniscus run`, made absolute
+    std::string scene_text;  ///< its text when the run started
+    std::string flow_type;   ///< /flow/type ("fluid" or a geometric flow)
+    int frame = 0;           ///< the frame this checkpoint was written with
+    int frames = 0;          ///< frames the run writes after frame 0 (--frames or the scene)
+    double time = 0.0;       ///< simulated time at `frame` (s)
+    double last_dt = 0.0;    ///< geometric flows: the last step's dt (for stats)
+    long long steps = 0;     ///< steps taken so far
+    int stalled_steps = 0;   ///< geometric flows: consecutive steps that advanced no time
     int max_intersecting_pairs = -1;
-    double nominal_xi = 0.0;    ///< the tracker's nominal ξ (crease-refined meshes), 0 if none
-    std::string stats_line;     ///< the frame's stats.jsonl line, without "checkpoint"
+    double nominal_xi = 0.0;  ///< the tracker's nominal ξ (crease-refined meshes), 0 if none
+    std::string stats_line;   ///< the frame's stats.jsonl line, without "checkpoint"
 };
 
 /// A checkpoint read back: its header and the solver state block.

@@ -374,6 +374,13 @@ public:
         m_pending_frame = -1;
     }
 
+    /// Removes the files of the frame whose line is not written yet (its checkpoint failed).
+    void discard_pending() {
+        remove_files(m_frame_files);
+        m_frame_files.clear();
+        m_pending_frame = -1;
+    }
+
 private:
     static void remove_files(const std::vector<std::string>& paths) {
         for (const std::string& path : paths)
@@ -750,9 +757,11 @@ public:
 
     /// If frame `frame` is due, writes the checkpoint with `save` as its state and the run's
     /// counters, then adds "checkpoint": {"bytes", "seconds"} to `line` (the frame's stats).
+    /// A checkpoint that cannot be written discards the frame's files from `writer` (the frame
+    /// then has no stats line) and throws WriteError.
     template <class SaveState>
     void write(int frame, double t, const RunResult& result, double last_dt, int stalled_steps,
-               nlohmann::json& line, const SaveState& save) {
+               nlohmann::json& line, FrameWriter& writer, const SaveState& save) {
         if (m_every <= 0 || (frame % m_every != 0 && frame != m_frames))
             return;
         const auto start = Clock::now();
@@ -770,7 +779,13 @@ public:
         h.stats_line = stored.dump();
         BinaryWriter state;
         save(state);
-        const std::uint64_t bytes = write_checkpoint(m_dir, h, state.bytes());
+        std::uint64_t bytes = 0;
+        try {
+            bytes = write_checkpoint(m_dir, h, state.bytes());
+        } catch (const WriteError&) {
+            writer.discard_pending();
+            throw;
+        }
         line["checkpoint"] = {{"bytes", bytes}, {"seconds", seconds_since(start)}};
     }
 
@@ -920,7 +935,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
         nlohmann::json line = fluid_frame_stats(0, 0.0, 0, sim, last,
                                                 {{"output", output_seconds}},
                                                 nlohmann::json::object());
-        checkpointer.write(0, 0.0, result, 0.0, 0, line, save);
+        checkpointer.write(0, 0.0, result, 0.0, 0, line, writer, save);
         writer.stats(line);
         result.frames_written = 1;
     }
@@ -962,7 +977,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
                                                  {"splits", splits},
                                                  {"step_shortenings", shortenings},
                                                  {"solves", solves.json(steps)}});
-        checkpointer.write(frame, t, result, 0.0, 0, line, save);
+        checkpointer.write(frame, t, result, 0.0, 0, line, writer, save);
         writer.stats(line);
         const std::string warning = solves.warning(frame, steps);
         if (!warning.empty() && !options.quiet) {
@@ -1036,7 +1051,8 @@ static void run_geometric_scene(const Scene& scene, const RunOptions& options,
         nlohmann::json line = frame_stats(frame, time, step_dt, steps, mesh, work);
         if (exact.enabled())
             line["exact_error"] = exact.stats(mesh, time);
-        checkpointer.write(frame, time, result, step_dt, stalled, line, [&](BinaryWriter& out) {
+        checkpointer.write(frame, time, result, step_dt, stalled, line, writer,
+                           [&](BinaryWriter& out) {
             tracker.save_state(out);
             exact.save_state(out);
         });

@@ -262,7 +262,7 @@ TEST_F(CliTest, ASecondRunIntoTheSameFolderReplacesTheFirst) {
     std::ofstream(out / "fields_0007.vdb.partial") << "stale";
     const Outcome o = run_meniscus("run " + scene + " --out " + out.string() + " --frames 1");
     ASSERT_EQ(o.exit_code, 0) << o.output;
-    EXPECT_NE(o.output.find("removed 11 files of an earlier run"), std::string::npos) << o.output;
+    EXPECT_NE(o.output.find("removed 12 files of an earlier run"), std::string::npos) << o.output;
     for (const char* gone :
          {"surface_0002.ply", "surface_0002.obj", "fields_0002.vdb", "fields_0007.vdb.partial"})
         EXPECT_FALSE(fs::exists(out / gone)) << gone;

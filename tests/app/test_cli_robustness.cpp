@@ -379,7 +379,7 @@ ChildResult run_and_signal(const fs::path& dir, const std::string& scene,
     return r;
 }
 
-void expect_complete_frames_only(const fs::path& out) {
+void expect_complete_frames_only(const fs::path& out, int min_lines = 1) {
     std::ifstream stats(out / "stats.jsonl", std::ios::binary);
     const std::string text((std::istreambuf_iterator<char>(stats)), std::istreambuf_iterator<char>());
     EXPECT_TRUE(text.empty() || text.back() == '\n') << "stats.jsonl ends in a partial line";
@@ -398,7 +398,7 @@ void expect_complete_frames_only(const fs::path& out) {
             EXPECT_LT(std::stoi(m[2]), lines) << name << " has no stats line";
         }
     }
-    EXPECT_GE(lines, 1);
+    EXPECT_GE(lines, min_lines);
 }
 
 TEST_F(Robustness, SigintStopsInsideALongStepWithin2Seconds) {
@@ -498,9 +498,11 @@ TEST_F(Robustness, FailedStatsLineIsCutBackWithItsFrameFiles) {
     // Frame 0's PLY (about 9 kB) fits under a 12 kB file-size bound, stats.jsonl (about
     // 640 bytes a line) outgrows it near frame 19: the line that fails is cut back off and its
     // frame's PLY removed, so every PLY left has a whole stats line.
+    // Checkpoints off: checkpoint.bin (tens of kB) would hit the bound first (the next test).
     std::string scene_text = small_scene(true, false);
     scene_text.replace(scene_text.find("\"frames\": 2"), 11, "\"frames\": 40");
     scene_text.replace(scene_text.find("\"end\": 0.04"), 11, "\"end\": 0.4");
+    scene_text.replace(scene_text.find("\"output\": {"), 11, "\"output\": {\"checkpoint_every\": 0, ");
     const fs::path out = m_dir / "out";
     ChildLimits limits = refusal_limits();
     limits.file_size_bytes = 12000;
@@ -513,6 +515,25 @@ TEST_F(Robustness, FailedStatsLineIsCutBackWithItsFrameFiles) {
         << describe(r);
     ASSERT_TRUE(fs::exists(out / "surface_0005.ply")) << "the bound should hit stats.jsonl late";
     expect_complete_frames_only(out);
+}
+
+TEST_F(Robustness, FailedCheckpointWriteIsExitOneAndLeavesCompleteFramesOnly) {
+    // The checkpoint is written after its frame's files and before its stats line: when it
+    // cannot be written the frame is cut back like a failed stats line, and no temporary is
+    // left (an earlier frame's checkpoint.bin stays whole).
+    std::string scene_text = small_scene(true, false);
+    const fs::path out = m_dir / "out";
+    ChildLimits limits = refusal_limits();
+    limits.file_size_bytes = 12000;
+    const ChildResult r = run(write("s.json", scene_text), {"--out", out.string()}, limits);
+    ASSERT_TRUE(r.exited) << describe(r);
+    EXPECT_EQ(r.exit_code, 1) << describe(r);
+    EXPECT_NE(r.output.find("cannot write output: " + (out / "checkpoint.bin").string() +
+                            ": write failed: File too large"),
+              std::string::npos)
+        << describe(r);
+    EXPECT_FALSE(fs::exists(out / "checkpoint.bin.partial")) << describe(r);
+    expect_complete_frames_only(out, 0);
 }
 
 TEST_F(Robustness, StalePartialFilesAreRemovedByTheNextRun) {

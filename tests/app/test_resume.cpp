@@ -147,8 +147,8 @@ int complete_stats_lines(const fs::path& dir) {
 /// files, in the checkpoint's own write.
 int run_with_kills(const std::string& scene, const fs::path& out, double duration, int frames,
                    int kills, unsigned seed,
-                   const std::function<ChildResult(std::vector<std::string>,
-                                                   const std::function<void(pid_t, double)>&)>& run) {
+                   const std::function<ChildResult(
+                       std::vector<std::string>, const std::function<void(pid_t, double)>&)>& run) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> part(0.0, 1.0);
     const double frame_seconds = duration / (frames + 1);
@@ -194,10 +194,9 @@ TEST_F(Resume, FluidRunKilledAtRandomMomentsEndsWithTheUninterruptedRunsFrames) 
     const fs::path reference = m_dir / "reference", killed = m_dir / "killed";
     const ChildResult r = meniscus({"run", scene, "--out", reference.string(), "--quiet"});
     ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
-    const int hits = run_with_kills(scene, killed, r.seconds, 8, 3, 38u,
-                                    [&](std::vector<std::string> a, const auto& w) {
-                                        return meniscus(std::move(a), w);
-                                    });
+    const int hits = run_with_kills(
+        scene, killed, r.seconds, 8, 3, 38u,
+        [&](std::vector<std::string> a, const auto& w) { return meniscus(std::move(a), w); });
     EXPECT_GE(hits, 2);
     expect_same_frames(reference, killed);
 }
@@ -207,10 +206,9 @@ TEST_F(Resume, GeometricFlowKilledAtRandomMomentsEndsWithTheUninterruptedRunsFra
     const fs::path reference = m_dir / "reference", killed = m_dir / "killed";
     const ChildResult r = meniscus({"run", scene, "--out", reference.string(), "--quiet"});
     ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
-    const int hits = run_with_kills(scene, killed, r.seconds, 8, 3, 3800u,
-                                    [&](std::vector<std::string> a, const auto& w) {
-                                        return meniscus(std::move(a), w);
-                                    });
+    const int hits = run_with_kills(
+        scene, killed, r.seconds, 8, 3, 3800u,
+        [&](std::vector<std::string> a, const auto& w) { return meniscus(std::move(a), w); });
     EXPECT_GE(hits, 2);
     expect_same_frames(reference, killed);
 }
@@ -233,8 +231,7 @@ TEST_F(Resume, StoppedRunResumesFromItsLastCheckpoint) {
 TEST_F(Resume, TruncatedOrDamagedCheckpointIsRefusedNamingTheFile) {
     const std::string scene = write("enright.json", FLOW_SCENE);
     const fs::path out = m_dir / "out";
-    ASSERT_EQ(meniscus({"run", scene, "--out", out.string(), "--quiet", "--frames", "2"})
-                  .exit_code,
+    ASSERT_EQ(meniscus({"run", scene, "--out", out.string(), "--quiet", "--frames", "2"}).exit_code,
               0);
     const std::string whole = read_bytes(out / "checkpoint.bin");
     ASSERT_GT(whole.size(), 1000u);
@@ -249,8 +246,7 @@ TEST_F(Resume, TruncatedOrDamagedCheckpointIsRefusedNamingTheFile) {
         std::ofstream(out / "checkpoint.bin", std::ios::binary | std::ios::trunc) << damaged;
         const ChildResult r = meniscus({"run", "--resume", out.string(), "--quiet"});
         EXPECT_TRUE(r.exited && r.exit_code == 2) << "byte " << at << ": " << describe(r);
-        EXPECT_NE(r.output.find((out / "checkpoint.bin").string()), std::string::npos)
-            << r.output;
+        EXPECT_NE(r.output.find((out / "checkpoint.bin").string()), std::string::npos) << r.output;
     }
     fs::remove(out / "checkpoint.bin");
     const ChildResult none = meniscus({"run", "--resume", out.string(), "--quiet"});
@@ -261,9 +257,9 @@ TEST_F(Resume, TruncatedOrDamagedCheckpointIsRefusedNamingTheFile) {
 TEST_F(Resume, ChangedSceneIsRefusedNamingWhatChangedUnlessAllowed) {
     const std::string scene = write("enright.json", FLOW_SCENE);
     const fs::path out = m_dir / "out";
-    ASSERT_EQ(meniscus({"run", scene, "--out", out.string(), "--quiet", "--max-steps", "5"})
-                  .exit_code,
-              0);
+    ASSERT_EQ(
+        meniscus({"run", scene, "--out", out.string(), "--quiet", "--max-steps", "5"}).exit_code,
+        0);
     nlohmann::json changed = nlohmann::json::parse(FLOW_SCENE);
     changed["time"]["dt"] = 0.01;
     write("enright.json", changed.dump(2));
@@ -278,9 +274,9 @@ TEST_F(Resume, ChangedSceneIsRefusedNamingWhatChangedUnlessAllowed) {
     // The same JSON written differently is the same scene.
     write("enright.json", nlohmann::json::parse(FLOW_SCENE).dump());
     const fs::path again = m_dir / "again";
-    ASSERT_EQ(meniscus({"run", scene, "--out", again.string(), "--quiet", "--max-steps", "5"})
-                  .exit_code,
-              0);
+    ASSERT_EQ(
+        meniscus({"run", scene, "--out", again.string(), "--quiet", "--max-steps", "5"}).exit_code,
+        0);
     write("enright.json", nlohmann::json::parse(FLOW_SCENE).dump(4));
     const ChildResult reformatted = meniscus({"run", "--resume", again.string(), "--quiet"});
     EXPECT_TRUE(reformatted.exited && reformatted.exit_code == 0) << describe(reformatted);
