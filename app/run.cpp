@@ -8,6 +8,7 @@
 #include "app/surface_checks.h"
 #include "common/atomic_file.h"
 #include "common/cancellation.h"
+#include "common/phase_clock.h"
 #include "coupling/simulation.h"
 #include "coupling/vdb_output.h"
 #include "tracker/flows/curl_noise.h"
@@ -648,6 +649,57 @@ void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::M
     }
 }
 
+/// Wall and process-CPU seconds of a frame's fluid steps per phase, summed over its steps, and
+/// of writing its files. stats.jsonl "seconds": the wall seconds by phase, the fluid step's own
+/// phases under "fluid_phases", and the same figures in CPU seconds under "cpu".
+struct FluidFrameTimes {
+    coupling::SimulationTimings coupled;
+    fluid::StepTimings fluid;
+    PhaseSeconds output;
+
+    void add(const coupling::SimulationStepReport& step) {
+        const coupling::SimulationTimings& c = step.timings;
+        coupled.rasterize += c.rasterize;
+        coupled.curvature += c.curvature;
+        coupled.fluid += c.fluid;
+        coupled.interpolate += c.interpolate;
+        coupled.volume_correction += c.volume_correction;
+        coupled.tracker += c.tracker;
+        coupled.total += c.total;
+        const fluid::StepTimings& f = step.fluid.timings;
+        fluid.advection += f.advection;
+        fluid.forces += f.forces;
+        fluid.viscosity += f.viscosity;
+        fluid.pressure_build += f.pressure_build;
+        fluid.pressure_solve += f.pressure_solve;
+        fluid.extrapolation += f.extrapolation;
+        fluid.total += f.total;
+    }
+
+    nlohmann::json json() const {
+        const auto figures = [&](double PhaseSeconds::*part) {
+            return nlohmann::json{
+                {"rasterize", coupled.rasterize.*part},
+                {"curvature", coupled.curvature.*part},
+                {"fluid", coupled.fluid.*part},
+                {"fluid_phases",
+                 {{"advection", fluid.advection.*part},
+                  {"forces", fluid.forces.*part},
+                  {"viscosity", fluid.viscosity.*part},
+                  {"pressure_build", fluid.pressure_build.*part},
+                  {"pressure_solve", fluid.pressure_solve.*part},
+                  {"extrapolation", fluid.extrapolation.*part}}},
+                {"interpolate", coupled.interpolate.*part},
+                {"volume_correction", coupled.volume_correction.*part},
+                {"tracker", coupled.tracker.*part},
+                {"output", output.*part}};
+        };
+        nlohmann::json seconds = figures(&PhaseSeconds::wall);
+        seconds["cpu"] = figures(&PhaseSeconds::cpu);
+        return seconds;
+    }
+};
+
 /// The linear solves of a frame's fluid steps.
 struct FrameSolves {
     long long pressure_iterations = 0, viscosity_iterations = 0, passes = 0;
@@ -930,11 +982,12 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
         result.simulated_time = t;
         result.frames_written = h.frame + 1;
     } else {
-        const double output_seconds =
-            writer.write(0, sim.tracker().mesh(), sim.vertex_velocities(), fields());
-        nlohmann::json line = fluid_frame_stats(0, 0.0, 0, sim, last,
-                                                {{"output", output_seconds}},
-                                                nlohmann::json::object());
+        FluidFrameTimes times;
+        PhaseClock output_clock;
+        writer.write(0, sim.tracker().mesh(), sim.vertex_velocities(), fields());
+        output_clock.lap_into(times.output);
+        nlohmann::json line =
+            fluid_frame_stats(0, 0.0, 0, sim, last, times.json(), nlohmann::json::object());
         checkpointer.write(0, 0.0, result, 0.0, 0, line, writer, save);
         writer.stats(line);
         result.frames_written = 1;
@@ -942,7 +995,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
     for (int frame = first_frame; frame <= frames; ++frame) {
         const double t_frame = frame == frames ? end_time : frame * frame_dt;
         long long steps = 0;
-        double rasterize = 0.0, fluid_s = 0.0, interpolate = 0.0, tracker_s = 0.0;
+        FluidFrameTimes times;
         long long intersecting = -1, merges = 0, splits = 0, shortenings = 0;
         FrameSolves solves;
         while (t < t_frame) {
@@ -950,10 +1003,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
                 return;
             last = sim.step(t_frame - t, scene.time.dt);
             solves.add(last.fluid);
-            rasterize += last.rasterize_seconds;
-            fluid_s += last.fluid_seconds;
-            interpolate += last.interpolate_seconds;
-            tracker_s += last.tracker_seconds;
+            times.add(last);
             intersecting = std::max<long long>(intersecting, last.integrate.intersecting_pairs);
             result.max_intersecting_pairs =
                 std::max(result.max_intersecting_pairs, last.integrate.intersecting_pairs);
@@ -964,14 +1014,10 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
             ++steps;
             ++result.steps;
         }
-        const double output_seconds =
-            writer.write(frame, sim.tracker().mesh(), sim.vertex_velocities(), fields());
-        nlohmann::json line = fluid_frame_stats(frame, t, steps, sim, last,
-                                                {{"rasterize", rasterize},
-                                                 {"fluid", fluid_s},
-                                                 {"interpolate", interpolate},
-                                                 {"tracker", tracker_s},
-                                                 {"output", output_seconds}},
+        PhaseClock output_clock;
+        writer.write(frame, sim.tracker().mesh(), sim.vertex_velocities(), fields());
+        output_clock.lap_into(times.output);
+        nlohmann::json line = fluid_frame_stats(frame, t, steps, sim, last, times.json(),
                                                 {{"intersecting_pairs", intersecting},
                                                  {"merges", merges},
                                                  {"splits", splits},

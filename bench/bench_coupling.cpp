@@ -1,25 +1,39 @@
-// Seconds per coupled step, per phase (rasterize: mesh → φ and κ; fluid: the Navier–Stokes step;
-// interpolate: grid → vertex velocities; tracker: improve, topology, collision-safe integrate),
-// for scenes/drop_merge.json and scenes/bubble_merge.json refined so that the longest box axis
-// has 64 cells (tracker edge = edge_length_cells · Δx as in the scene). Each benchmark iteration
-// is one Simulation::step() from the scene's initial state (initial velocities applied as
-// `meniscus run` does); the counters are per-step means over the iterations (wall seconds per
-// phase, and cpu_s: process CPU seconds of all threads, which a loaded machine inflates less),
-// plus the live triangle counts before the first and after the last step.
+// The coupled step (Simulation::step) by phase, in µs of CPU and of wall time per cell per step.
 //
-// Run: bench_coupling [--benchmark_filter=drop]; MENISCUS_BENCH_CELLS=<n> changes the 64 and
-// MENISCUS_BENCH_STEPS=<n> the number of steps (default 20).
+// BM_DropMerge, BM_BubbleMerge: scenes/drop_merge.json and scenes/bubble_merge.json refined so
+// that the longest box axis has 64 cells (MENISCUS_BENCH_CELLS), tracker edge =
+// edge_length_cells · Δx as in the scene, MENISCUS_BENCH_STEPS steps (default 20) from the
+// scene's initial state.
+//
+// BM_BubblePairCube/N/T: the resolution study of issue 36 — two 1.5 mm air bubbles in water
+// (density ratio 1000, μ and σ of water, gravity) in a 1 cm cube of N³ cells, pushed towards
+// each other as in bubble_merge, with T TBB threads (tbb::global_control). One untimed step
+// first (it builds the first pressure and the solver's workspaces), then
+// MENISCUS_BENCH_CUBE_STEPS timed steps (default 3).
+//
+// Counters: <phase>_cpu_us and <phase>_wall_us, µs per cell per step, for the coupling's phases
+// (rasterize, curvature, fluid, interpolate, volume_correction, tracker), the fluid step's
+// (advection, forces, viscosity, pressure_build, pressure_solve, extrapolation) and the total.
+// CPU is the process's (all threads), so at 2 threads CPU ≈ 2 × wall when both are busy. After
+// the run a table of the same figures is printed, one column per benchmark.
+//
+// Run: bench_coupling [--benchmark_filter=Cube/128]
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
-#include <ctime>
+#include <map>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "app/run.h"
 #include "app/scene.h"
+#include "common/phase_clock.h"
 #include "coupling/simulation.h"
 
 namespace {
@@ -28,6 +42,7 @@ using namespace meniscus;
 
 constexpr int DEFAULT_LONGEST_AXIS_CELLS = 64;
 constexpr int DEFAULT_STEPS = 20;
+constexpr int DEFAULT_CUBE_STEPS = 3;
 
 int env_int(const char* name, int fallback) {
     const char* value = std::getenv(name);
@@ -45,51 +60,158 @@ app::Scene refined_scene(const std::string& name, int cells) {
     return scene;
 }
 
-void coupled_step(benchmark::State& state, const std::string& name) {
-    const app::Scene scene =
-        refined_scene(name, env_int("MENISCUS_BENCH_CELLS", DEFAULT_LONGEST_AXIS_CELLS));
+/// Two bubbles of radius 1.5 mm, 0.3 mm apart, in water in a 1 cm cube of `cells`³ cells.
+app::Scene bubble_pair_cube(int cells) {
+    const std::string json = R"({
+      "name": "bench_bubble_pair_cube",
+      "flow": {"type": "fluid"},
+      "domain": {"min": [0, 0, 0], "size": [0.01, 0.01, 0.01], "cells": )" +
+                             std::to_string(cells) + R"(},
+      "fluid": {"gravity": [0, 0, -9.81], "mode": "two_phase"},
+      "coupling": {"edge_length_cells": 1.0, "volume_correction": true, "curvature_smoothing": 1},
+      "tracker": {"topology": {"merge_distance_fraction": 0.5}},
+      "surface": {"inside": "gas", "shape": {"type": "union", "shapes": [
+        {"type": "sphere", "center": [0.00335, 0.005, 0.004], "radius": 0.0015},
+        {"type": "sphere", "center": [0.00665, 0.005, 0.004], "radius": 0.0015}]}},
+      "initial_velocity": [
+        {"shape": {"type": "sphere", "center": [0.00335, 0.005, 0.004], "radius": 0.0015},
+         "velocity": [0.05, 0, 0]},
+        {"shape": {"type": "sphere", "center": [0.00665, 0.005, 0.004], "radius": 0.0015},
+         "velocity": [-0.05, 0, 0]}],
+      "time": {"end": 0.01, "frames": 1}
+    })";
+    return app::parse_scene(json, "bench_coupling.cpp", ".");
+}
+
+/// Phase seconds summed over the timed steps.
+struct PhaseTotals {
+    std::vector<std::pair<std::string, PhaseSeconds>> phases;
+
+    void add(const std::string& name, const PhaseSeconds& seconds) {
+        for (auto& [n, s] : phases)
+            if (n == name) {
+                s += seconds;
+                return;
+            }
+        phases.emplace_back(name, seconds);
+    }
+
+    void add(const coupling::SimulationStepReport& report) {
+        const coupling::SimulationTimings& c = report.timings;
+        const fluid::StepTimings& f = report.fluid.timings;
+        add("rasterize", c.rasterize);
+        add("curvature", c.curvature);
+        add("fluid", c.fluid);
+        add("  advection", f.advection);
+        add("  forces", f.forces);
+        add("  viscosity", f.viscosity);
+        add("  pressure_build", f.pressure_build);
+        add("  pressure_solve", f.pressure_solve);
+        add("  extrapolation", f.extrapolation);
+        add("interpolate", c.interpolate);
+        add("volume_correction", c.volume_correction);
+        add("tracker", c.tracker);
+        add("total", c.total);
+    }
+};
+
+/// µs per cell per step of every benchmark that ran, by phase: {benchmark: {phase: (cpu, wall)}}.
+std::vector<std::pair<std::string, std::vector<std::pair<std::string, std::pair<double, double>>>>>
+    g_table;
+
+void coupled_steps(benchmark::State& state, const app::Scene& scene, int warmup_steps,
+                   const std::string& label) {
     std::unique_ptr<coupling::Simulation> sim =
         std::make_unique<coupling::Simulation>(app::make_fluid_simulation(scene));
     const fluid::MacGrid& grid = sim->fluid().grid();
-    double rasterize = 0.0, fluid_step = 0.0, interpolate = 0.0, tracker_step = 0.0, dt = 0.0;
+    const double cells = static_cast<double>(grid.nx()) * grid.ny() * grid.nz();
+    for (int i = 0; i < warmup_steps; ++i)
+        sim->step(scene.time.dt);
     const int initial_triangles = sim->tracker().mesh().count_live_triangles();
-    const std::clock_t cpu_start = std::clock();
+    PhaseTotals totals;
+    double dt = 0.0;
+    long long steps = 0;
     for (auto _ : state) {
         const coupling::SimulationStepReport report = sim->step(scene.time.dt);
-        rasterize += report.rasterize_seconds;
-        fluid_step += report.fluid_seconds;
-        interpolate += report.interpolate_seconds;
-        tracker_step += report.tracker_seconds;
+        totals.add(report);
         dt += report.dt;
+        ++steps;
     }
-    const double cpu = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
-    const auto mean = [&](double total) {
-        return benchmark::Counter(total, benchmark::Counter::kAvgIterations);
-    };
-    state.counters["rasterize_s"] = mean(rasterize);
-    state.counters["fluid_s"] = mean(fluid_step);
-    state.counters["interpolate_s"] = mean(interpolate);
-    state.counters["tracker_s"] = mean(tracker_step);
-    state.counters["cpu_s"] = mean(cpu);
-    state.counters["dt_s"] = mean(dt);
-    state.counters["cells"] = static_cast<double>(grid.nx()) * grid.ny() * grid.nz();
+    const double per = 1e6 / (cells * static_cast<double>(std::max<long long>(steps, 1)));
+    std::vector<std::pair<std::string, std::pair<double, double>>> row;
+    for (const auto& [name, seconds] : totals.phases) {
+        std::string key = name;
+        key.erase(0, key.find_first_not_of(' '));
+        state.counters[key + "_cpu_us"] = seconds.cpu * per;
+        state.counters[key + "_wall_us"] = seconds.wall * per;
+        row.emplace_back(name, std::make_pair(seconds.cpu * per, seconds.wall * per));
+    }
+    state.counters["dt_s"] = dt / static_cast<double>(std::max<long long>(steps, 1));
+    state.counters["cells"] = cells;
     state.counters["tris_start"] = initial_triangles;
     state.counters["tris_end"] = sim->tracker().mesh().count_live_triangles();
     state.SetLabel(std::to_string(grid.nx()) + "x" + std::to_string(grid.ny()) + "x" +
                    std::to_string(grid.nz()) + " cells");
+    g_table.emplace_back(label, std::move(row));
 }
 
 void BM_DropMerge(benchmark::State& state) {
-    coupled_step(state, "drop_merge");
+    const int cells = env_int("MENISCUS_BENCH_CELLS", DEFAULT_LONGEST_AXIS_CELLS);
+    coupled_steps(state, refined_scene("drop_merge", cells), 0,
+                  "drop_merge " + std::to_string(cells));
 }
 void BM_BubbleMerge(benchmark::State& state) {
-    coupled_step(state, "bubble_merge");
+    const int cells = env_int("MENISCUS_BENCH_CELLS", DEFAULT_LONGEST_AXIS_CELLS);
+    coupled_steps(state, refined_scene("bubble_merge", cells), 0,
+                  "bubble_merge " + std::to_string(cells));
+}
+
+void BM_BubblePairCube(benchmark::State& state) {
+    const int cells = static_cast<int>(state.range(0));
+    const int threads = static_cast<int>(state.range(1));
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                              static_cast<std::size_t>(threads));
+    coupled_steps(state, bubble_pair_cube(cells), 1,
+                  "cube " + std::to_string(cells) + "^3 " + std::to_string(threads) + "T");
 }
 
 const int STEPS = env_int("MENISCUS_BENCH_STEPS", DEFAULT_STEPS);
+const int CUBE_STEPS = env_int("MENISCUS_BENCH_CUBE_STEPS", DEFAULT_CUBE_STEPS);
 BENCHMARK(BM_DropMerge)->Iterations(STEPS)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_BubbleMerge)->Iterations(STEPS)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BubblePairCube)
+    ->ArgsProduct({{64, 128, 192}, {1, 2}})
+    ->ArgNames({"cells", "threads"})
+    ->Iterations(CUBE_STEPS)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// The table of µs per cell per step, CPU / wall, one column per benchmark that ran.
+void print_table() {
+    if (g_table.empty())
+        return;
+    std::printf("\nµs per cell per step, CPU / wall\n%-20s", "phase");
+    for (const auto& [label, row] : g_table)
+        std::printf(" | %-19s", label.c_str());
+    std::printf("\n");
+    for (std::size_t p = 0; p < g_table.front().second.size(); ++p) {
+        std::printf("%-20s", g_table.front().second[p].first.c_str());
+        for (const auto& [label, row] : g_table) {
+            const auto& [cpu, wall] = row[p].second;
+            std::printf(" | %8.3f / %8.3f", cpu, wall);
+        }
+        std::printf("\n");
+    }
+}
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv))
+        return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    print_table();
+    return 0;
+}

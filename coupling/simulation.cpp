@@ -3,7 +3,6 @@
 #include "tracker/mesh_measures.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -12,15 +11,9 @@ namespace meniscus::coupling {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 /// Cap on a vertex's sub-grid displacement per step, in mesh edge lengths: the damping is meant
 /// for mesh-scale wrinkles; a sliver's outsized cotangent weights must not throw a vertex far.
 constexpr double MAX_SUBGRID_STEP_EDGES = 0.25;
-
-double seconds_since(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 }  // namespace
 
@@ -90,43 +83,54 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     bind(time_left, StepLimit::frame_end);
 
     // (2) Mesh → grid.
-    auto start = Clock::now();
-    fluid::InterfaceInput interface =
-        interface_from_mesh(mesh, grid, m_options.rasterize, m_options.surface_tension);
-    report.rasterize_seconds = seconds_since(start);
+    SimulationTimings& timings = report.timings;
+    PhaseClock clock;
+    RasterizeResult raster = rasterize_mesh(mesh, grid, m_options.rasterize);
+    clock.lap_into(timings.rasterize);
+    fluid::InterfaceInput interface;
+    face_curvatures(mesh, grid, raster, m_options.surface_tension, interface);
+    interface.phi = std::move(raster.phi);
+    clock.lap_into(timings.curvature);
 
     // (3) Fluid.
-    start = Clock::now();
     report.fluid = m_fluid.step(report.dt, interface);
     m_phi = interface.phi;
-    report.fluid_seconds = seconds_since(start);
+    clock.lap_into(timings.fluid);
 
     // (5, first half) Mesh improvement and topology changes happen before velocities are set.
-    start = Clock::now();
-    if (m_volumes)
+    if (m_volumes) {
         m_volumes->begin_step();
+        clock.lap_into(timings.volume_correction);
+    }
     report.improve = m_tracker->improve();
     report.topology = m_tracker->change_topology();  // compacts
-    if (m_volumes)
+    clock.lap_into(timings.tracker);
+    if (m_volumes) {
         report.volume = m_volumes->match_components();
-    report.tracker_seconds = seconds_since(start);
+        clock.lap_into(timings.volume_correction);
+    }
 
     // (4) Grid → mesh.
-    start = Clock::now();
     m_vertex_velocities =
         interpolate_vertex_velocities(m_fluid.grid(), mesh, m_options.interpolate);
     for (const tracker::Vec3& v : m_vertex_velocities)
         report.max_vertex_speed = std::max(report.max_vertex_speed, v.norm());
-    report.interpolate_seconds = seconds_since(start);
+    clock.lap_into(timings.interpolate);
 
     // (6) Volume correction rides on the collision-safe motion; (5) integrate.
-    start = Clock::now();
     std::vector<tracker::Vec3> velocities = m_vertex_velocities;
     add_subgrid_tension(velocities, report.dt);
-    if (m_volumes)
+    clock.lap_into(timings.curvature);
+    if (m_volumes) {
         m_volumes->add_correction(velocities, report.dt);
+        clock.lap_into(timings.volume_correction);
+    }
     report.integrate = m_tracker->integrate(velocities, report.dt);
-    report.tracker_seconds += seconds_since(start);
+    clock.lap_into(timings.tracker);
+    for (const PhaseSeconds* phase : {&timings.rasterize, &timings.curvature, &timings.fluid,
+                                      &timings.interpolate, &timings.volume_correction,
+                                      &timings.tracker})
+        timings.total += *phase;
     m_time += report.integrate.time_advanced;
     return report;
 }

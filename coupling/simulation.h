@@ -7,6 +7,7 @@
 /// improve(), change_topology() and collision-safe integrate(); (6) optional volume correction per
 /// connected component (through merges and pinch-offs).
 
+#include "common/phase_clock.h"
 #include "coupling/interpolate.h"
 #include "coupling/rasterize.h"
 #include "coupling/surface_tension.h"
@@ -35,7 +36,19 @@ struct SimulationOptions {
 enum class StepLimit { cfl, capillary, frame_end, max_dt };
 const char* to_string(StepLimit limit);
 
-/// What one coupled step did. Seconds are wall clock per phase.
+/// Wall-clock and process-CPU seconds of the phases of a coupled step; `fluid` is split
+/// further in SimulationStepReport::fluid.timings.
+struct SimulationTimings {
+    PhaseSeconds rasterize;          ///< mesh → φ on the grid (OpenVDB level set)
+    PhaseSeconds curvature;          ///< κ on the faces the interface crosses, sub-grid tension
+    PhaseSeconds fluid;              ///< FluidSolver::step
+    PhaseSeconds interpolate;        ///< grid velocities → mesh vertices
+    PhaseSeconds volume_correction;  ///< component matching and the volume-restoring motion
+    PhaseSeconds tracker;            ///< improvement, topology changes, collision-safe motion
+    PhaseSeconds total;
+};
+
+/// What one coupled step did.
 struct SimulationStepReport {
     double dt = 0.0;
     StepLimit limit = StepLimit::max_dt;
@@ -45,10 +58,7 @@ struct SimulationStepReport {
     tracker::TopologyReport topology;
     VolumeReport volume;
     double max_vertex_speed = 0.0;  ///< m/s, interpolated
-    double rasterize_seconds = 0.0;
-    double fluid_seconds = 0.0;
-    double interpolate_seconds = 0.0;
-    double tracker_seconds = 0.0;
+    SimulationTimings timings;
 };
 
 /// Owns the tracker and the fluid solver and steps them together.

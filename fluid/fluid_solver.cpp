@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
-#include <chrono>
 #include <stdexcept>
 
 #include "fluid/extrapolation.h"
@@ -12,12 +11,6 @@
 namespace meniscus::fluid {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 const FluidOptions& validated(const FluidOptions& options) {
     options.validate();
@@ -78,12 +71,11 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
     }
     interface.validate(m_grid);
     StepResult result;
-    const Clock::time_point step_start = Clock::now();
-
-    Clock::time_point start = Clock::now();
+    PhaseClock step_clock;
+    PhaseClock clock;
     advect_velocity(m_grid, dt, m_options.advection);
     m_grid.zero_wall_normal_velocity();
-    result.timings.advection = seconds_since(start);
+    clock.lap_into(result.timings.advection);
 
     if (m_options.viscous_pressure.coupling == ViscousPressureCoupling::split) {
         split_step(dt, interface, result);
@@ -92,34 +84,33 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
     }
 
     if (m_options.mode == FluidMode::free_surface) {
-        start = Clock::now();
+        clock = PhaseClock();
         extrapolate_velocity(m_grid, interface, m_options.extrapolation_layers);
-        result.timings.extrapolation = seconds_since(start);
+        clock.lap_into(result.timings.extrapolation);
     }
     m_was_liquid = liquid_cells(interface.phi);
-    result.timings.total = seconds_since(step_start);
+    step_clock.lap_into(result.timings.total);
     return result;
 }
 
 void FluidSolver::split_step(double dt, const InterfaceInput& interface, StepResult& result) {
     // Viscosity before gravity: the body force is then balanced by the pressure of the same
     // projection, so a fluid at rest in hydrostatic equilibrium stays exactly at rest.
-    Clock::time_point start = Clock::now();
+    PhaseClock clock;
     result.viscosity = m_viscosity.solve(m_grid, interface, m_options.phases, m_options.mode,
                                          m_options.walls, dt, m_options.viscosity,
                                          m_options.pressure.min_liquid_fraction);
-    result.timings.viscosity = seconds_since(start);
+    clock.lap_into(result.timings.viscosity);
 
-    start = Clock::now();
     apply_gravity(m_grid, m_options.gravity, dt);
-    result.timings.forces = seconds_since(start);
+    clock.lap_into(result.timings.forces);
 
-    start = Clock::now();
     const ProjectionResult projection = project(m_grid, interface, m_options.phases, m_options.mode,
                                                 dt, m_options.pressure, m_pressure);
     result.pressure = projection.solve;
     result.max_divergence = projection.max_divergence;
-    result.timings.pressure = seconds_since(start);
+    result.timings.pressure_build += projection.build_time;
+    result.timings.pressure_solve += projection.solve_time;
 }
 
 void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
@@ -145,7 +136,7 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
     result.pressure.converged = true;
 
     // Momentum with the previous pressure: u = A⁻¹(ρ/Δt u_a + ρ g − G_J p⁽ⁿ⁾).
-    Clock::time_point start = Clock::now();
+    PhaseClock clock;
     if (m_was_liquid.empty()) {
         // No previous pressure: start from the one that balances the body force and the jump
         // (hydrostatic plus Laplace), so that rest is exact from the first step.
@@ -163,17 +154,15 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
         // or the viscous solve would drag the liquid along with them (rest would not be exact).
         extrapolate_velocity(m_grid, interface, m_options.extrapolation_layers);
     }
-    result.timings.forces += seconds_since(start);
-    start = Clock::now();
+    clock.lap_into(result.timings.forces);
     add_solve(result.viscosity,
               m_viscosity.solve(m_grid, interface, phases, mode, m_options.walls, dt,
                                 m_options.viscosity, m_options.pressure.min_liquid_fraction));
-    result.timings.viscosity += seconds_since(start);
+    clock.lap_into(result.timings.viscosity);
 
     if (max_iterations > 0) {
         // Uzawa–PCG on T δ = −D u, T = Gᵀ A⁻¹ G: u ← u + V(δ) with V(δ) = −A⁻¹ G δ the viscous
         // solve of the velocity impulse −Δt/ρ G δ, so the residual is always −D u.
-        start = Clock::now();
         const double dx = m_grid.dx();
         std::vector<double> r = unknown_divergence(m_grid, interface, mode);
         for (double& x : r)
@@ -205,8 +194,10 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
         MacGrid impulse(1, 1, 1, dx);
         double rz = 0.0;
         if (!result.converged_passes) {
+            clock.lap_into(result.timings.pressure_solve);
             system = build_pressure_system(m_grid, interface, increment_phases, mode, dt,
                                            m_options.pressure);
+            clock.lap_into(result.timings.pressure_build);
             add_solve(result.pressure, apply_cahouet_chabard(system, m_options.pressure,
                                                              interface, phases, mode, dt, dx, r,
                                                              z));
@@ -215,10 +206,9 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
             rz = dot(r, z);
             impulse = MacGrid(m_grid.nx(), m_grid.ny(), m_grid.nz(), dx, m_grid.origin());
         }
-        result.timings.pressure += seconds_since(start);
+        clock.lap_into(result.timings.pressure_solve);
         for (int iteration = 0; iteration < max_iterations && !result.converged_passes;
              ++iteration) {
-            start = Clock::now();
             for (int axis = 0; axis < 3; ++axis)
                 impulse.velocity(axis).fill(0.0);
             apply_pressure_gradient(impulse, interface, increment_phases, mode, dt,
@@ -227,12 +217,13 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
                       m_viscosity.solve(impulse, interface, phases, mode, m_options.walls, dt,
                                         m_options.viscosity,
                                         m_options.pressure.min_liquid_fraction));
-            result.timings.viscosity += seconds_since(start);
-            start = Clock::now();
+            clock.lap_into(result.timings.viscosity);
             q = unknown_divergence(impulse, interface, mode);  // T s
             const double curvature = dot(direction.storage(), q);
-            if (!(curvature > 0.0))
-                break;  // breakdown (inexact inner solves): the projection below still applies
+            if (!(curvature > 0.0)) {
+                clock.lap_into(result.timings.pressure_solve);
+                break;
+            }  // breakdown (inexact inner solves): the projection below still applies
             const double alpha = rz / curvature;
             for (int axis = 0; axis < 3; ++axis) {
                 std::vector<double>& u = m_grid.velocity(axis).storage();
@@ -257,12 +248,12 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
                 for (std::size_t c = 0; c < r.size(); ++c)
                     direction[c] = z[c] + beta * direction[c];
             }
-            result.timings.pressure += seconds_since(start);
+            clock.lap_into(result.timings.pressure_solve);
         }
     }
 
     // The projection of what is left: u divergence-free to the pressure solver's tolerance.
-    start = Clock::now();
+    clock = PhaseClock();
     const ProjectionResult projection = project(m_grid, interface, increment_phases, mode, dt,
                                                 m_options.pressure, m_increment);
     for (std::size_t c = 0; c < m_pressure.size(); ++c)
@@ -271,7 +262,11 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
         remove_unknown_mean(interface, mode, m_pressure);
     add_solve(result.pressure, projection.solve);
     result.max_divergence = projection.max_divergence;
-    result.timings.pressure += seconds_since(start);
+    // The block's time less the assembly is solving.
+    PhaseSeconds solving = clock.lap();
+    solving -= projection.build_time;
+    result.timings.pressure_build += projection.build_time;
+    result.timings.pressure_solve += solving;
 }
 
 TimeStepLimits FluidSolver::time_step_limits() const {

@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include "common/phase_clock.h"
+
 #include "fluid/advection.h"
 #include "fluid/array3.h"
 #include "fluid/interface_input.h"
@@ -38,14 +40,18 @@ struct FluidOptions {
     void validate() const;
 };
 
-/// Wall-clock seconds spent in each phase of a step.
+/// Wall-clock and process-CPU seconds of each phase of a step. The coupled scheme's Uzawa
+/// passes count their viscous solves as viscosity and their pressure preconditioning as
+/// pressure_solve; the step's first hydrostatic start and the previous pressure's gradient count
+/// as forces.
 struct StepTimings {
-    double advection = 0.0;
-    double forces = 0.0;
-    double viscosity = 0.0;
-    double pressure = 0.0;
-    double extrapolation = 0.0;
-    double total = 0.0;
+    PhaseSeconds advection;
+    PhaseSeconds forces;          ///< gravity (and the previous pressure's gradient)
+    PhaseSeconds viscosity;       ///< implicit viscous solves
+    PhaseSeconds pressure_build;  ///< assembling the pressure systems
+    PhaseSeconds pressure_solve;  ///< solving them and applying the gradients
+    PhaseSeconds extrapolation;   ///< free_surface: velocity into the void
+    PhaseSeconds total;
 };
 
 /// What a step did.

@@ -238,12 +238,15 @@ double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface
 ProjectionResult project(MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,
                          FluidMode mode, double dt, const PressureOptions& options,
                          Array3<double>& pressure) {
+    PhaseClock clock;
     const PressureSystem system = build_pressure_system(grid, interface, phases, mode, dt, options);
     ProjectionResult result;
+    result.build_time = clock.lap();
     result.solve = solve_pressure_system(system, options, pressure);
     result.singular = system.singular;
     apply_pressure_gradient(grid, interface, phases, mode, dt, options, pressure);
     result.max_divergence = max_fluid_divergence(grid, interface, mode);
+    result.solve_time = clock.lap();
     return result;
 }
 

@@ -15,6 +15,7 @@
 
 #include <vector>
 
+#include "common/phase_clock.h"
 #include "fluid/array3.h"
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
@@ -82,6 +83,8 @@ struct ProjectionResult {
     SolveResult solve;            ///< linear solve outcome
     double max_divergence = 0.0;  ///< max |∇·u| over unknown cells after projection, 1/s
     bool singular = false;        ///< the system was pure Neumann (p only up to a constant)
+    PhaseSeconds build_time;      ///< assembling the system
+    PhaseSeconds solve_time;      ///< the linear solve and applying the gradient
 };
 
 /// Full projection: build, solve, apply the gradient. `pressure` receives p (Pa).

@@ -39,13 +39,6 @@ double angle_between(const Vec3& a, const Vec3& b) {
     return std::atan2(a.cross(b).norm(), a.dot(b));
 }
 
-std::vector<int> ring_of(const SurfaceMesh& mesh, int vi) {
-    std::vector<int> ring;
-    for (int ei : mesh.vertex_edges(vi))
-        ring.push_back(mesh.other_vertex(ei, vi));
-    return ring;
-}
-
 /// Number of groups (2: crease, 3: corner; 0: none) the normals fall into: groups whose means
 /// turn by more than `angle` from each other and whose members stay within
 /// MAX_GROUP_SPREAD_FRACTION of that turn of their own mean.

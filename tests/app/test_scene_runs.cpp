@@ -154,6 +154,45 @@ TEST(FluidScenes, StatsReportTheViscousAndPressureSolves) {
     EXPECT_TRUE(solves.contains("viscous_pressure_passes"));
 }
 
+TEST(FluidScenes, StatsSplitTheStepIntoPhasesInWallAndCpuSeconds) {
+    // Issue 36: where the time goes, per phase of the coupling and of the fluid step.
+    const std::vector<nlohmann::json> lines = static_drop_stats(1, [](Scene&) {}, "meniscus_phases");
+    ASSERT_EQ(lines.size(), 2u);
+    const char* coupled[] = {"rasterize",         "curvature", "fluid", "interpolate",
+                             "volume_correction", "tracker",   "output"};
+    const char* fluid[] = {"advection",      "forces",         "viscosity",
+                           "pressure_build", "pressure_solve", "extrapolation"};
+    for (const nlohmann::json& line : lines) {
+        const int frame = line["frame"];
+        for (const nlohmann::json* seconds : {&line["seconds"], &line["seconds"]["cpu"]}) {
+            double phase_sum = 0.0;
+            for (const char* name : fluid) {
+                ASSERT_TRUE((*seconds)["fluid_phases"].contains(name)) << name;
+                const double s = (*seconds)["fluid_phases"][name];
+                EXPECT_GE(s, 0.0) << name;
+                phase_sum += s;
+            }
+            for (const char* name : coupled) {
+                ASSERT_TRUE(seconds->contains(name)) << name;
+                EXPECT_GE((*seconds)[name].get<double>(), 0.0) << name;
+                if (frame == 0 && std::string(name) != "output") {
+                    EXPECT_EQ((*seconds)[name].get<double>(), 0.0) << name << " before any step";
+                }
+            }
+            // The fluid step is its phases, up to the bookkeeping between them.
+            const double fluid_total = (*seconds)["fluid"];
+            EXPECT_LE(phase_sum, fluid_total * (1.0 + 1e-9) + 1e-9);
+            if (frame > 0) {
+                EXPECT_GE(phase_sum, 0.7 * fluid_total);
+                EXPECT_GT((*seconds)["fluid_phases"]["pressure_solve"].get<double>(), 0.0);
+                EXPECT_GT((*seconds)["fluid_phases"]["viscosity"].get<double>(), 0.0);
+                EXPECT_GT((*seconds)["rasterize"].get<double>(), 0.0);
+                EXPECT_GT((*seconds)["tracker"].get<double>(), 0.0);
+            }
+        }
+    }
+}
+
 TEST(FluidScenes, UnconvergedSolvesAreCountedInTheStats) {
     // One viscous CG iteration cannot reach 1e-12: every step is counted as unconverged (and
     // `meniscus run` warns; the CLI test checks the message).
