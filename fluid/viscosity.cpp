@@ -293,39 +293,53 @@ private:
         }
     }
 
-    /// ∂_b x_a at edge e (dual-lattice indices), with the no-slip mirror at walls.
-    double derivative(const std::vector<double>& x, int a, int b, const Index3& e) const {
-        Index3 lo = e;
-        --lo[b];
-        if (e[b] == 0) {
-            return MIRROR_FACTOR * x[face_flat(a, e)] / m_dx;
-        }
-        if (e[b] == m_n[b]) {
-            return -MIRROR_FACTOR * x[face_flat(a, lo)] / m_dx;
-        }
-        return (x[face_flat(a, e)] - x[face_flat(a, lo)]) / m_dx;
+    /// Flat-index step of axis `axis` in the face array of component a.
+    std::size_t face_stride(int a, int axis) const {
+        const Index3& d = m_face_dims[a];
+        return axis == 0 ? 1 : axis == 1 ? static_cast<std::size_t>(d[0])
+                                         : static_cast<std::size_t>(d[0]) * d[1];
     }
 
-    /// τ(edge) = 2Δt W_e (∂_b x_a + ∂_a x_b) on edges parallel to c, (a, b) the other axes.
+    /// τ(edge) = 2Δt W_e (∂_b x_a + ∂_a x_b) on edges parallel to c, (a, b) the other axes; ∂
+    /// one-sided at walls, where a no-slip wall mirrors the tangential velocity, with the face indices
+    /// stepped along each row instead of recomputed.
     void shear_stresses(const std::vector<double>& x) const {
         for (int c = 0; c < 3; ++c) {
             const int a = (c + 1) % 3;
             const int b = (c + 2) % 3;
             const Array3<double>& weight = m_edge_weight[c];
             Array3<double>& tau = m_shear_stress[c];
+            const std::size_t step_a = face_stride(a, b);  // x_a along b
+            const std::size_t step_b = face_stride(b, a);  // x_b along a
+            const int n_a = m_n[a];
+            const int n_b = m_n[b];
             tbb::parallel_for(
                 tbb::blocked_range<int>(0, weight.nk()), [&](const tbb::blocked_range<int>& r) {
                     for (int k = r.begin(); k != r.end(); ++k) {
                         for (int j = 0; j < weight.nj(); ++j) {
+                            // Face indices of (0, j, k) in arrays a and b (an index one past
+                            // an array's end on axis b or a is only ever used minus its step).
+                            const std::size_t row_a = face_flat(a, {0, j, k});
+                            const std::size_t row_b = face_flat(b, {0, j, k});
+                            const std::size_t edge_row = weight.index(0, j, k);
                             for (int i = 0; i < weight.ni(); ++i) {
-                                const double w = weight(i, j, k);
+                                const double w = weight[edge_row + i];
                                 if (w == 0.0) {
-                                    tau(i, j, k) = 0.0;
+                                    tau[edge_row + i] = 0.0;
                                     continue;
                                 }
                                 const Index3 e = {i, j, k};
-                                tau(i, j, k) = 2.0 * m_dt * w *
-                                               (derivative(x, a, b, e) + derivative(x, b, a, e));
+                                const std::size_t fa = row_a + i;
+                                const std::size_t fb = row_b + i;
+                                const double d_ab =
+                                    e[b] == 0     ? MIRROR_FACTOR * x[fa] / m_dx
+                                    : e[b] == n_b ? -MIRROR_FACTOR * x[fa - step_a] / m_dx
+                                                  : (x[fa] - x[fa - step_a]) / m_dx;
+                                const double d_ba =
+                                    e[a] == 0     ? MIRROR_FACTOR * x[fb] / m_dx
+                                    : e[a] == n_a ? -MIRROR_FACTOR * x[fb - step_b] / m_dx
+                                                  : (x[fb] - x[fb - step_b]) / m_dx;
+                                tau[edge_row + i] = 2.0 * m_dt * w * (d_ab + d_ba);
                             }
                         }
                     }
@@ -338,24 +352,52 @@ private:
         const double inv_dx = 1.0 / m_dx;
         for (int a = 0; a < 3; ++a) {
             const Array3<double>& sigma = m_normal_stress[a];
-            for_each_face(a, [&](const Index3& f, std::size_t flat) {
-                Index3 lo = f;
-                --lo[a];
-                double sum = (sigma(lo[0], lo[1], lo[2]) - sigma(f[0], f[1], f[2])) * inv_dx;
-                for (int b = 0; b < 3; ++b) {
-                    if (b == a) {
-                        continue;
+            const Index3& dims = m_face_dims[a];
+            const std::size_t cell_step = a == 0   ? 1
+                                          : a == 1 ? static_cast<std::size_t>(m_n[0])
+                                                   : static_cast<std::size_t>(m_n[0]) * m_n[1];
+            // The two shear arrays this component meets, in the order b = 0, 1, 2 (b ≠ a).
+            std::array<int, 2> other{};
+            std::array<std::size_t, 2> edge_step{};
+            int count = 0;
+            for (int b = 0; b < 3; ++b) {
+                if (b == a)
+                    continue;
+                const Array3<double>& tau = m_shear_stress[3 - a - b];
+                other[count] = b;
+                edge_step[count] = b == 0   ? 1
+                                   : b == 1 ? static_cast<std::size_t>(tau.ni())
+                                            : static_cast<std::size_t>(tau.ni()) * tau.nj();
+                ++count;
+            }
+            tbb::parallel_for(
+                tbb::blocked_range<int>(0, dims[2]), [&](const tbb::blocked_range<int>& r) {
+                    for (int k = r.begin(); k != r.end(); ++k) {
+                        for (int j = 0; j < dims[1]; ++j) {
+                            const std::size_t face_row = face_flat(a, {0, j, k});
+                            for (int i = 0; i < dims[0]; ++i) {
+                                const Index3 f = {i, j, k};
+                                if (f[a] == 0 || f[a] == m_n[a])
+                                    continue;
+                                // Cell f lies above the face, cell f − e_a below it.
+                                const std::size_t cell = sigma.index(i, j, k);
+                                double sum = (sigma[cell - cell_step] - sigma[cell]) * inv_dx;
+                                for (int t = 0; t < 2; ++t) {
+                                    const int b = other[t];
+                                    const Array3<double>& tau = m_shear_stress[3 - a - b];
+                                    const std::size_t below = tau.index(i, j, k);
+                                    const double c_below =
+                                        (f[b] == 0 ? MIRROR_FACTOR : 1.0) * inv_dx;
+                                    const double c_above =
+                                        -(f[b] + 1 == m_n[b] ? MIRROR_FACTOR : 1.0) * inv_dx;
+                                    sum += tau[below] * c_below +
+                                           tau[below + edge_step[t]] * c_above;
+                                }
+                                y[face_row + i] = sum;
+                            }
+                        }
                     }
-                    const Array3<double>& tau = m_shear_stress[3 - a - b];
-                    Index3 above = f;
-                    ++above[b];
-                    const double c_below = (f[b] == 0 ? MIRROR_FACTOR : 1.0) * inv_dx;
-                    const double c_above = -(above[b] == m_n[b] ? MIRROR_FACTOR : 1.0) * inv_dx;
-                    sum += tau(f[0], f[1], f[2]) * c_below +
-                           tau(above[0], above[1], above[2]) * c_above;
-                }
-                y[flat] = sum;
-            });
+                });
         }
     }
 
@@ -383,9 +425,47 @@ void ViscosityOptions::validate() const {
         throw std::invalid_argument("ViscosityOptions.weights: unknown weighting");
 }
 
+/// What the operator was last built from: the coupled scheme's Uzawa passes solve again with
+/// the same interface and time step, so the operator and its diagonal are reused.
+struct OperatorKey {
+    std::array<int, 3> cells{};
+    double dx = 0.0, dt = 0.0, min_liquid_fraction = 0.0;
+    double rho_liquid = 0.0, rho_gas = 0.0, mu_liquid = 0.0, mu_gas = 0.0;
+    FluidMode mode = FluidMode::two_phase;
+    std::array<WallType, 6> walls{};
+    ViscosityWeights weights = ViscosityWeights::sharp;
+    std::vector<double> phi;
+
+    OperatorKey() = default;
+    OperatorKey(const MacGrid& grid, const PhaseOptions& phases,
+                FluidMode mode_in, const WallOptions& walls_in, double dt_in,
+                double min_fraction, ViscosityWeights weights_in)
+        : cells{grid.nx(), grid.ny(), grid.nz()},
+          dx(grid.dx()),
+          dt(dt_in),
+          min_liquid_fraction(min_fraction),
+          rho_liquid(phases.rho_liquid),
+          rho_gas(phases.rho_gas),
+          mu_liquid(phases.mu_liquid),
+          mu_gas(phases.mu_gas),
+          mode(mode_in),
+          walls{walls_in.x_min, walls_in.x_max, walls_in.y_min,
+                walls_in.y_max, walls_in.z_min, walls_in.z_max},
+          weights(weights_in) {}
+
+    /// Equal settings (the stored φ is compared separately, without copying the new one).
+    bool same_settings(const OperatorKey& o) const {
+        return cells == o.cells && dx == o.dx && dt == o.dt &&
+               min_liquid_fraction == o.min_liquid_fraction && rho_liquid == o.rho_liquid &&
+               rho_gas == o.rho_gas && mu_liquid == o.mu_liquid && mu_gas == o.mu_gas &&
+               mode == o.mode && walls == o.walls && weights == o.weights;
+    }
+};
+
 /// Work arrays kept between ViscositySolver::solve calls.
 struct ViscositySolver::Workspace {
     ViscousOperator op;
+    OperatorKey key;  ///< what `op` and `diagonal` were built from (empty φ: nothing yet)
     std::vector<double> u_star, fixed, x, b, r, z, p, q, diagonal;
 };
 
@@ -413,7 +493,17 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     }
     Workspace& ws = *m_workspace;
     ViscousOperator& op = ws.op;
-    op.build(grid, interface.phi, phases, mode, walls, dt, min_liquid_fraction, options.weights);
+    OperatorKey key(grid, phases, mode, walls, dt, min_liquid_fraction, options.weights);
+    const bool reuse = !ws.key.phi.empty() && ws.key.same_settings(key) &&
+                       ws.key.phi == interface.phi.storage();
+    if (!reuse) {
+        ws.key.phi.clear();  // nothing valid until the build is complete
+        ws.diagonal.clear();
+        op.build(grid, interface.phi, phases, mode, walls, dt, min_liquid_fraction,
+                 options.weights);
+        key.phi = interface.phi.storage();
+        ws.key = std::move(key);
+    }
     const std::vector<char>& unknown = op.unknown();
     const std::vector<double>& density = op.density();
     const std::size_t n = op.size();
@@ -441,7 +531,8 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         std::vector<double>& z = ws.z;
         std::vector<double>& p = ws.p;
         std::vector<double>& q = ws.q;
-        op.diagonal(ws.diagonal);
+        if (ws.diagonal.empty())
+            op.diagonal(ws.diagonal);
         const std::vector<double>& diagonal = ws.diagonal;
         r.resize(n);
         z.resize(n);

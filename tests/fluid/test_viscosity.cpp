@@ -268,5 +268,54 @@ TEST(Viscosity, StopsWhenCancelled) {
                     .converged);
 }
 
+TEST(FluidViscosity, ReusedSolverRebuildsForANewInterfaceOrStep) {
+    // The solver keeps its operator while φ and Δt stay the same (the coupled scheme's Uzawa
+    // passes); any change must rebuild it: every reused solve equals a fresh solver's, bit for bit.
+    const int n = 10;
+    const double dx = 1.0 / n;
+    MacGrid start(n, n, n, dx);
+    for (int axis = 0; axis < 3; ++axis) {
+        std::vector<double>& u = start.velocity(axis).storage();
+        for (std::size_t f = 0; f < u.size(); ++f)
+            u[f] = std::sin(0.37 * static_cast<double>(f) + axis);
+    }
+    start.zero_wall_normal_velocity();
+    PhaseOptions phases;
+    phases.rho_liquid = 1000.0;
+    phases.rho_gas = 1.0;
+    phases.mu_liquid = 1.0;
+    phases.mu_gas = 0.01;
+    const WallOptions walls = WallOptions::all(WallType::no_slip);
+    ViscosityOptions options;
+    options.iteration.tolerance = 1e-10;
+    const auto drop = [&](double radius) {
+        InterfaceInput interface(start);
+        for (int k = 0; k < n; ++k)
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i)
+                    interface.phi(i, j, k) =
+                        (Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5) * dx -
+                         Eigen::Vector3d::Constant(0.5))
+                            .norm() -
+                        radius;
+        return interface;
+    };
+    const InterfaceInput small = drop(0.2), large = drop(0.3);
+    struct Case {
+        const InterfaceInput* interface;
+        double dt;
+    };
+    ViscositySolver reused;
+    for (const Case& c : {Case{&small, 0.1}, Case{&small, 0.1}, Case{&large, 0.1},
+                          Case{&large, 0.05}, Case{&small, 0.05}}) {
+        MacGrid a = start, b = start;
+        reused.solve(a, *c.interface, phases, FluidMode::two_phase, walls, c.dt, options);
+        ViscositySolver fresh;
+        fresh.solve(b, *c.interface, phases, FluidMode::two_phase, walls, c.dt, options);
+        for (int axis = 0; axis < 3; ++axis)
+            EXPECT_EQ(a.velocity(axis).storage(), b.velocity(axis).storage()) << "axis " << axis;
+    }
+}
+
 }  // namespace
 }  // namespace meniscus::fluid
