@@ -160,32 +160,46 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
     return system;
 }
 
-SolveResult solve_pressure_system(const PressureSystem& system, const PressureOptions& options,
-                                  Array3<double>& pressure) {
+PressureSystemSolver::PressureSystemSolver(const PressureSystem& system,
+                                           const PressureOptions& options)
+    : m_system(system), m_options(options) {
     options.validate();
-    const PoissonMatrix& a = system.matrix;
-    std::vector<double> solution;
-    SolveResult result;
     switch (options.solver) {
-        case PressureSolver::mic0_pcg: {
-            const Mic0Preconditioner preconditioner(a, options.mic0);
-            result = solve_pcg(a, system.rhs, preconditioner, options.iteration, system.singular,
-                               solution);
+        case PressureSolver::mic0_pcg:
+            m_preconditioner = std::make_unique<Mic0Preconditioner>(system.matrix, options.mic0);
             break;
-        }
-        case PressureSolver::multigrid_pcg: {
-            const MultigridPreconditioner preconditioner(a, options.multigrid);
-            result = solve_pcg(a, system.rhs, preconditioner, options.iteration, system.singular,
-                               solution);
+        case PressureSolver::multigrid_pcg:
+            m_preconditioner =
+                std::make_unique<MultigridPreconditioner>(system.matrix, options.multigrid);
             break;
-        }
         case PressureSolver::eigen_ic_cg:
-            result = solve_eigen_ic_cg(a, system.rhs, options.iteration, system.singular, solution);
             break;
     }
+}
+
+PressureSystemSolver::~PressureSystemSolver() = default;
+
+SolveResult PressureSystemSolver::solve(const std::vector<double>& rhs,
+                                        Array3<double>& pressure) const {
+    const PoissonMatrix& a = m_system.matrix;
+    if (rhs.size() != a.size())
+        throw std::invalid_argument("PressureSystemSolver::solve: right-hand side of " +
+                                    std::to_string(rhs.size()) + " values for " +
+                                    std::to_string(a.size()) + " cells");
+    std::vector<double> solution;
+    const SolveResult result =
+        m_preconditioner ? solve_pcg(a, rhs, *m_preconditioner, m_options.iteration,
+                                     m_system.singular, solution)
+                         : solve_eigen_ic_cg(a, rhs, m_options.iteration, m_system.singular,
+                                             solution);
     pressure.resize(a.ni(), a.nj(), a.nk(), 0.0);
     pressure.storage() = std::move(solution);
     return result;
+}
+
+SolveResult solve_pressure_system(const PressureSystem& system, const PressureOptions& options,
+                                  Array3<double>& pressure) {
+    return PressureSystemSolver(system, options).solve(system.rhs, pressure);
 }
 
 void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,

@@ -13,6 +13,7 @@
 /// uses the ghost value that puts p = σκ at the θ-weighted interface position, adding β/θ to the
 /// diagonal (θ clamped below by min_liquid_fraction). Pressure in Pa.
 
+#include <memory>
 #include <vector>
 
 #include "common/phase_clock.h"
@@ -65,6 +66,26 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
 /// zero in cells that are not unknowns; mean zero when the system is singular).
 SolveResult solve_pressure_system(const PressureSystem& system, const PressureOptions& options,
                                   Array3<double>& pressure);
+
+/// Solves one assembled system for several right-hand sides, building its preconditioner once
+/// (the coupled scheme's Uzawa passes solve the same system every pass). Keeps a reference to
+/// `system`, which must outlive it; same results as solve_pressure_system().
+class PressureSystemSolver {
+public:
+    /// Throws std::invalid_argument naming the field when `options` are out of range.
+    PressureSystemSolver(const PressureSystem& system, const PressureOptions& options);
+    ~PressureSystemSolver();
+    PressureSystemSolver(const PressureSystemSolver&) = delete;
+    PressureSystemSolver& operator=(const PressureSystemSolver&) = delete;
+
+    /// Solves A p = rhs (`rhs` sized like the system; its own right-hand side is not used).
+    SolveResult solve(const std::vector<double>& rhs, Array3<double>& pressure) const;
+
+private:
+    const PressureSystem& m_system;
+    PressureOptions m_options;
+    std::unique_ptr<Preconditioner> m_preconditioner;  ///< null for eigen_ic_cg
+};
 
 /// u ← u − factor · Δt/ρ_f ∇p on every face adjacent to an unknown cell (ghost-fluid gradients
 /// with the σκ jump; free-surface faces use the interface Dirichlet value σκ). Wall faces are

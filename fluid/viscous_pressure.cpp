@@ -88,16 +88,16 @@ void carry_pressure_to_new_phase(const std::vector<char>& was_liquid,
             }
 }
 
-SolveResult apply_cahouet_chabard(const PressureSystem& system, const PressureOptions& options,
-                           const InterfaceInput& interface, const PhaseOptions& phases,
-                           FluidMode mode, double dt, double dx, const std::vector<double>& r,
-                           std::vector<double>& z) {
-    PressureSystem scaled = system;
+SolveResult apply_cahouet_chabard(const PressureSystem& system, const PressureSystemSolver& solver,
+                                  const InterfaceInput& interface, const PhaseOptions& phases,
+                                  FluidMode mode, double dt, double dx,
+                                  const std::vector<double>& r, std::vector<double>& z) {
     const double scale = dx * dx / dt;
+    std::vector<double> rhs(r.size(), 0.0);
     for (std::size_t c = 0; c < r.size(); ++c)
-        scaled.rhs[c] = system.matrix.diag[c] > 0.0 ? scale * r[c] : 0.0;
+        rhs[c] = system.matrix.diag[c] > 0.0 ? scale * r[c] : 0.0;
     Array3<double> poisson;
-    const SolveResult solve = solve_pressure_system(scaled, options, poisson);
+    const SolveResult solve = solver.solve(rhs, poisson);
     const double mu_gas = mode == FluidMode::two_phase ? phases.mu_gas : 0.0;
     z.assign(r.size(), 0.0);
     double sum = 0.0;

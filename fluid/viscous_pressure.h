@@ -80,12 +80,12 @@ void carry_pressure_to_new_phase(const std::vector<char>& was_liquid,
 /// Cahouet–Chabard's preconditioner of the coupled scheme for a residual r (the negative
 /// velocity divergence per cell, 1/s): z = A_p⁻¹ (Δx²/Δt) r + 2 μ_c r on the unknown cells,
 /// with A_p the pressure system's matrix (build_pressure_system()) for the same interface and
-/// time step; z has zero mean over the unknowns when the system is singular. Pa. Returns the
-/// Poisson solve's outcome.
-SolveResult apply_cahouet_chabard(const PressureSystem& system, const PressureOptions& options,
-                           const InterfaceInput& interface, const PhaseOptions& phases,
-                           FluidMode mode, double dt, double dx, const std::vector<double>& r,
-                           std::vector<double>& z);
+/// time step, solved by `solver` (built on `system`); z has zero mean over the unknowns when the
+/// system is singular. Pa. Returns the Poisson solve's outcome.
+SolveResult apply_cahouet_chabard(const PressureSystem& system, const PressureSystemSolver& solver,
+                                  const InterfaceInput& interface, const PhaseOptions& phases,
+                                  FluidMode mode, double dt, double dx,
+                                  const std::vector<double>& r, std::vector<double>& z);
 
 /// The divergence (1/s) of every unknown cell of the pressure system (all cells in two_phase,
 /// liquid cells in free_surface), 0 elsewhere, in the Array3 layout of the cells.

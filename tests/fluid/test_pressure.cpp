@@ -297,6 +297,44 @@ TEST(FluidPressureBackends, AllBackendsAgreeOnABubbleSystem) {
     EXPECT_LT(diff_eigen, 1e-6 * scale);
 }
 
+TEST(FluidPressureBackends, OneSolverServesManyRightHandSidesLikeFreshSolves) {
+    // The coupled scheme's passes reuse one preconditioner (its multigrid scratch vectors too):
+    // every solve must equal a fresh solve_pressure_system() bit for bit, for each backend.
+    const int n = 12;
+    MacGrid grid(n, n, n, 0.05);
+    PhaseOptions phases;
+    InterfaceInput interface(grid);
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i)
+                interface.phi(i, j, k) =
+                    0.2 - (grid.cell_centre(i, j, k) - Eigen::Vector3d(0.3, 0.3, 0.25)).norm();
+    for (int axis = 0; axis < 3; ++axis)
+        interface.kappa(axis).fill(-2.0 / 0.2);
+    add_gravity(grid, 1e-3);
+    PressureSystem system =
+        build_pressure_system(grid, interface, phases, FluidMode::two_phase, 1e-3, {});
+    for (PressureSolver backend : {PressureSolver::mic0_pcg, PressureSolver::multigrid_pcg,
+                                   PressureSolver::eigen_ic_cg}) {
+        const PressureOptions options = tight_options(backend);
+        const PressureSystemSolver solver(system, options);
+        const std::vector<double> first = system.rhs;
+        for (int round = 0; round < 3; ++round) {
+            PressureSystem varied = system;
+            for (std::size_t c = 0; c < varied.rhs.size(); ++c)
+                varied.rhs[c] = first[c] * (1.0 + 0.5 * round) + 0.01 * std::sin(0.1 * c * round);
+            Array3<double> reused, fresh;
+            const SolveResult a = solver.solve(varied.rhs, reused);
+            const SolveResult b = solve_pressure_system(varied, options, fresh);
+            EXPECT_TRUE(a.converged);
+            EXPECT_EQ(a.iterations, b.iterations);
+            EXPECT_EQ(reused.storage(), fresh.storage()) << "round " << round;
+        }
+        Array3<double> unused;
+        EXPECT_THROW(solver.solve(std::vector<double>(3, 0.0), unused), std::invalid_argument);
+    }
+}
+
 TEST(FluidPressureBackends, MultigridMatchesMic0OnOddGridsWithManyInterfaces) {
     // Odd, unequal grid sizes (ragged coarsening), drops over a pool, random κ and u*: the
     // multigrid preconditioner must give the same pressure as MIC(0) in both modes.
