@@ -13,7 +13,9 @@
 //
 // Counters: <phase>_cpu_us and <phase>_wall_us, µs per cell per step, for the coupling's phases
 // (rasterize, curvature, fluid, interpolate, volume_correction, tracker), the fluid step's
-// (advection, forces, viscosity, pressure_build, pressure_solve, extrapolation) and the total.
+// (advection, forces, viscosity, pressure_build, pressure_solve, extrapolation) and the total;
+// pcg_its, visc_cg_its, passes: pressure PCG and viscous CG iterations and the coupled scheme's
+// Uzawa passes, per step.
 // CPU is the process's (all threads), so at 2 threads CPU ≈ 2 × wall when both are busy. After
 // the run a table of the same figures is printed, one column per benchmark.
 //
@@ -130,11 +132,14 @@ void coupled_steps(benchmark::State& state, const app::Scene& scene, int warmup_
     const int initial_triangles = sim->tracker().mesh().count_live_triangles();
     PhaseTotals totals;
     double dt = 0.0;
-    long long steps = 0;
+    long long steps = 0, pressure_iterations = 0, viscosity_iterations = 0, passes = 0;
     for (auto _ : state) {
         const coupling::SimulationStepReport report = sim->step(scene.time.dt);
         totals.add(report);
         dt += report.dt;
+        pressure_iterations += report.fluid.pressure.iterations;
+        viscosity_iterations += report.fluid.viscosity.iterations;
+        passes += report.fluid.passes;
         ++steps;
     }
     const double per = 1e6 / (cells * static_cast<double>(std::max<long long>(steps, 1)));
@@ -146,7 +151,11 @@ void coupled_steps(benchmark::State& state, const app::Scene& scene, int warmup_
         state.counters[key + "_wall_us"] = seconds.wall * per;
         row.emplace_back(name, std::make_pair(seconds.cpu * per, seconds.wall * per));
     }
-    state.counters["dt_s"] = dt / static_cast<double>(std::max<long long>(steps, 1));
+    const double n = static_cast<double>(std::max<long long>(steps, 1));
+    state.counters["dt_s"] = dt / n;
+    state.counters["pcg_its"] = static_cast<double>(pressure_iterations) / n;
+    state.counters["visc_cg_its"] = static_cast<double>(viscosity_iterations) / n;
+    state.counters["passes"] = static_cast<double>(passes) / n;
     state.counters["cells"] = cells;
     state.counters["tris_start"] = initial_triangles;
     state.counters["tris_end"] = sim->tracker().mesh().count_live_triangles();
