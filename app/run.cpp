@@ -658,22 +658,8 @@ struct FluidFrameTimes {
     PhaseSeconds output;
 
     void add(const coupling::SimulationStepReport& step) {
-        const coupling::SimulationTimings& c = step.timings;
-        coupled.rasterize += c.rasterize;
-        coupled.curvature += c.curvature;
-        coupled.fluid += c.fluid;
-        coupled.interpolate += c.interpolate;
-        coupled.volume_correction += c.volume_correction;
-        coupled.tracker += c.tracker;
-        coupled.total += c.total;
-        const fluid::StepTimings& f = step.fluid.timings;
-        fluid.advection += f.advection;
-        fluid.forces += f.forces;
-        fluid.viscosity += f.viscosity;
-        fluid.pressure_build += f.pressure_build;
-        fluid.pressure_solve += f.pressure_solve;
-        fluid.extrapolation += f.extrapolation;
-        fluid.total += f.total;
+        coupled += step.timings;
+        fluid += step.fluid.timings;
     }
 
     nlohmann::json json() const {

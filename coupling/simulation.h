@@ -18,6 +18,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 
 namespace meniscus::coupling {
 
@@ -46,6 +47,17 @@ struct SimulationTimings {
     PhaseSeconds volume_correction;  ///< component matching and the volume-restoring motion
     PhaseSeconds tracker;            ///< improvement, topology changes, collision-safe motion
     PhaseSeconds total;
+
+    /// Adds every phase of `other` (a frame's sum over its steps).
+    SimulationTimings& operator+=(const SimulationTimings& other) {
+        for (auto [mine, theirs] :
+             {std::pair{&rasterize, &other.rasterize}, {&curvature, &other.curvature},
+              {&fluid, &other.fluid}, {&interpolate, &other.interpolate},
+              {&volume_correction, &other.volume_correction}, {&tracker, &other.tracker},
+              {&total, &other.total}})
+            *mine += *theirs;
+        return *this;
+    }
 };
 
 /// What one coupled step did.

@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include <utility>
+
 #include "common/phase_clock.h"
 
 #include "fluid/advection.h"
@@ -52,6 +54,17 @@ struct StepTimings {
     PhaseSeconds pressure_solve;  ///< solving them and applying the gradients
     PhaseSeconds extrapolation;   ///< free_surface: velocity into the void
     PhaseSeconds total;
+
+    /// Adds every phase of `other` (a frame's sum over its steps).
+    StepTimings& operator+=(const StepTimings& other) {
+        for (auto [mine, theirs] :
+             {std::pair{&advection, &other.advection}, {&forces, &other.forces},
+              {&viscosity, &other.viscosity}, {&pressure_build, &other.pressure_build},
+              {&pressure_solve, &other.pressure_solve}, {&extrapolation, &other.extrapolation},
+              {&total, &other.total}})
+            *mine += *theirs;
+        return *this;
+    }
 };
 
 /// What a step did.
