@@ -129,6 +129,12 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
                              "the viscous solve, one projection (steady states right but reached "
                              "slowly at large νΔt/Δx²); `split`: viscosity, then projection "
                              "(steady states depend on the time step)");
+                  enum_field(r, "preconditioner", o.viscous_pressure.preconditioner,
+                             {{"poisson_solve", fluid::SchurPreconditioner::poisson_solve},
+                              {"v_cycle", fluid::SchurPreconditioner::v_cycle}},
+                             "coupled: the Cahouet–Chabard preconditioner's inverse pressure "
+                             "Laplacian, a full `poisson_solve` or one multigrid `v_cycle` "
+                             "(multigrid_pcg only; experimental)");
                   r.integer("max_passes", o.viscous_pressure.max_passes, Range::between(1, 100),
                             "", "coupled: most viscous + pressure passes per step");
                   r.number("pass_tolerance", o.viscous_pressure.pass_tolerance,

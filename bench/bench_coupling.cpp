@@ -9,7 +9,8 @@
 // (density ratio 1000, μ and σ of water, gravity) in a 1 cm cube of N³ cells, pushed towards
 // each other as in bubble_merge, with T TBB threads (tbb::global_control). One untimed step
 // first (it builds the first pressure and the solver's workspaces), then
-// MENISCUS_BENCH_CUBE_STEPS timed steps (default 3).
+// MENISCUS_BENCH_CUBE_STEPS timed steps (default 3); MENISCUS_BENCH_SCHUR sets
+// /fluid/viscous_pressure/preconditioner (default poisson_solve).
 //
 // Counters: <phase>_cpu_us and <phase>_wall_us, µs per cell per step, for the coupling's phases
 // (rasterize, curvature, fluid, interpolate, volume_correction, tracker), the fluid step's
@@ -64,12 +65,16 @@ app::Scene refined_scene(const std::string& name, int cells) {
 
 /// Two bubbles of radius 1.5 mm, 0.3 mm apart, in water in a 1 cm cube of `cells`³ cells.
 app::Scene bubble_pair_cube(int cells) {
+    const char* schur_env = std::getenv("MENISCUS_BENCH_SCHUR");
+    const std::string schur = schur_env != nullptr ? schur_env : "poisson_solve";
     const std::string json = R"({
       "name": "bench_bubble_pair_cube",
       "flow": {"type": "fluid"},
       "domain": {"min": [0, 0, 0], "size": [0.01, 0.01, 0.01], "cells": )" +
                              std::to_string(cells) + R"(},
-      "fluid": {"gravity": [0, 0, -9.81], "mode": "two_phase"},
+      "fluid": {"gravity": [0, 0, -9.81], "mode": "two_phase",
+                "viscous_pressure": {"preconditioner": ")" +
+                             schur + R"("}},
       "coupling": {"edge_length_cells": 1.0, "volume_correction": true, "curvature_smoothing": 1},
       "tracker": {"topology": {"merge_distance_fraction": 0.5}},
       "surface": {"inside": "gas", "shape": {"type": "union", "shapes": [

@@ -201,8 +201,9 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
                                            m_options.pressure);
             clock.lap_into(result.timings.pressure_build);
             poisson = std::make_unique<PressureSystemSolver>(system, m_options.pressure);
-            add_solve(result.pressure, apply_cahouet_chabard(system, *poisson, interface, phases,
-                                                             mode, dt, dx, r, z));
+            add_solve(result.pressure, apply_cahouet_chabard(system, *poisson, scheme.preconditioner,
+                                                             interface, phases, mode, dt, dx, r,
+                                                             z));
             direction.resize(m_grid.nx(), m_grid.ny(), m_grid.nz(), 0.0);
             direction.storage() = z;
             rz = dot(r, z);
@@ -243,8 +244,8 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
             result.converged_passes = result.pass_change <= scheme.pass_tolerance;
             if (!result.converged_passes) {
                 add_solve(result.pressure,
-                          apply_cahouet_chabard(system, *poisson, interface, phases, mode, dt,
-                                                dx, r, z));
+                          apply_cahouet_chabard(system, *poisson, scheme.preconditioner,
+                                                interface, phases, mode, dt, dx, r, z));
                 const double rz_new = dot(r, z);
                 const double beta = rz_new / rz;
                 rz = rz_new;

@@ -197,6 +197,29 @@ SolveResult PressureSystemSolver::solve(const std::vector<double>& rhs,
     return result;
 }
 
+SolveResult PressureSystemSolver::precondition(const std::vector<double>& rhs,
+                                               Array3<double>& pressure) const {
+    if (!m_preconditioner)
+        return solve(rhs, pressure);
+    const PoissonMatrix& a = m_system.matrix;
+    if (rhs.size() != a.size())
+        throw std::invalid_argument("PressureSystemSolver::precondition: right-hand side of " +
+                                    std::to_string(rhs.size()) + " values for " +
+                                    std::to_string(a.size()) + " cells");
+    std::vector<double> b = rhs, z;
+    if (m_system.singular)
+        remove_active_mean(a, b);
+    m_preconditioner->apply(b, z);
+    if (m_system.singular)
+        remove_active_mean(a, z);
+    pressure.resize(a.ni(), a.nj(), a.nk(), 0.0);
+    pressure.storage() = std::move(z);
+    SolveResult result;
+    result.converged = true;
+    result.iterations = 1;
+    return result;
+}
+
 SolveResult solve_pressure_system(const PressureSystem& system, const PressureOptions& options,
                                   Array3<double>& pressure) {
     return PressureSystemSolver(system, options).solve(system.rhs, pressure);

@@ -80,6 +80,9 @@ public:
 
     /// Solves A p = rhs (`rhs` sized like the system; its own right-hand side is not used).
     SolveResult solve(const std::vector<double>& rhs, Array3<double>& pressure) const;
+    /// p = M⁻¹ rhs, one application of the preconditioner (rhs projected to zero mean first
+    /// when the system is singular, p then too); a full solve() for eigen_ic_cg, which has none.
+    SolveResult precondition(const std::vector<double>& rhs, Array3<double>& pressure) const;
 
 private:
     const PressureSystem& m_system;

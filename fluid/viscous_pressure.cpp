@@ -29,6 +29,9 @@ void ViscousPressureOptions::validate() const {
         coupling != ViscousPressureCoupling::incremental &&
         coupling != ViscousPressureCoupling::coupled)
         throw std::invalid_argument("ViscousPressureOptions.coupling: unknown scheme");
+    if (preconditioner != SchurPreconditioner::poisson_solve &&
+        preconditioner != SchurPreconditioner::v_cycle)
+        throw std::invalid_argument("ViscousPressureOptions.preconditioner: unknown kind");
     if (max_passes < 1)
         throw std::invalid_argument("ViscousPressureOptions.max_passes must be at least 1");
     if (!(pass_tolerance > 0.0 && pass_tolerance < 1.0))
@@ -89,15 +92,18 @@ void carry_pressure_to_new_phase(const std::vector<char>& was_liquid,
 }
 
 SolveResult apply_cahouet_chabard(const PressureSystem& system, const PressureSystemSolver& solver,
-                                  const InterfaceInput& interface, const PhaseOptions& phases,
-                                  FluidMode mode, double dt, double dx,
-                                  const std::vector<double>& r, std::vector<double>& z) {
+                                  SchurPreconditioner how, const InterfaceInput& interface,
+                                  const PhaseOptions& phases, FluidMode mode, double dt,
+                                  double dx, const std::vector<double>& r,
+                                  std::vector<double>& z) {
     const double scale = dx * dx / dt;
     std::vector<double> rhs(r.size(), 0.0);
     for (std::size_t c = 0; c < r.size(); ++c)
         rhs[c] = system.matrix.diag[c] > 0.0 ? scale * r[c] : 0.0;
     Array3<double> poisson;
-    const SolveResult solve = solver.solve(rhs, poisson);
+    const SolveResult solve = how == SchurPreconditioner::v_cycle
+                                  ? solver.precondition(rhs, poisson)
+                                  : solver.solve(rhs, poisson);
     const double mu_gas = mode == FluidMode::two_phase ? phases.mu_gas : 0.0;
     z.assign(r.size(), 0.0);
     double sum = 0.0;

@@ -48,8 +48,18 @@ namespace meniscus::fluid {
 enum class ViscousPressureCoupling { split, incremental, coupled };
 
 /// Options of the viscosity–pressure coupling.
+/// How the coupled scheme's Cahouet–Chabard preconditioner applies the inverse pressure
+/// Laplacian A_p⁻¹.
+enum class SchurPreconditioner {
+    poisson_solve,  ///< a full PCG solve to the pressure tolerance
+    /// one multigrid V-cycle (a fixed symmetric operator, so the Uzawa–PCG stays a plain PCG;
+    /// other pressure backends fall back to poisson_solve)
+    v_cycle
+};
+
 struct ViscousPressureOptions {
     ViscousPressureCoupling coupling = ViscousPressureCoupling::coupled;
+    SchurPreconditioner preconditioner = SchurPreconditioner::poisson_solve;
     /// coupled: the most Uzawa–PCG iterations per step (each one viscous and one pressure
     /// solve; ≥ 1).
     int max_passes = 8;
@@ -80,12 +90,14 @@ void carry_pressure_to_new_phase(const std::vector<char>& was_liquid,
 /// Cahouet–Chabard's preconditioner of the coupled scheme for a residual r (the negative
 /// velocity divergence per cell, 1/s): z = A_p⁻¹ (Δx²/Δt) r + 2 μ_c r on the unknown cells,
 /// with A_p the pressure system's matrix (build_pressure_system()) for the same interface and
-/// time step, solved by `solver` (built on `system`); z has zero mean over the unknowns when the
-/// system is singular. Pa. Returns the Poisson solve's outcome.
+/// time step, applied by `solver` (built on `system`) as `how` says; z has zero mean over the
+/// unknowns when the system is singular. Pa. Returns the Poisson solve's outcome (a V-cycle:
+/// converged, 1 iteration, residual 0).
 SolveResult apply_cahouet_chabard(const PressureSystem& system, const PressureSystemSolver& solver,
-                                  const InterfaceInput& interface, const PhaseOptions& phases,
-                                  FluidMode mode, double dt, double dx,
-                                  const std::vector<double>& r, std::vector<double>& z);
+                                  SchurPreconditioner how, const InterfaceInput& interface,
+                                  const PhaseOptions& phases, FluidMode mode, double dt,
+                                  double dx, const std::vector<double>& r,
+                                  std::vector<double>& z);
 
 /// The divergence (1/s) of every unknown cell of the pressure system (all cells in two_phase,
 /// liquid cells in free_surface), 0 elsewhere, in the Array3 layout of the cells.
