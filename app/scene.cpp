@@ -161,7 +161,8 @@ void visit_fields(V& v, CouplingOptions& o) {
              "", "damping rate β of mesh-scale wrinkles the grid cannot resolve (0 = off)");
     enum_field(v, "velocity_interpolation", o.simulation.interpolate.method,
                {{"trilinear", coupling::VelocityInterpolation::trilinear},
-                {"quadratic_bspline", coupling::VelocityInterpolation::quadratic_bspline}},
+                {"quadratic_bspline", coupling::VelocityInterpolation::quadratic_bspline},
+                {"one_sided", coupling::VelocityInterpolation::one_sided}},
                "grid → vertex velocity reconstruction");
     v.number("capillary_safety", o.simulation.capillary_safety, Range{0.0, 1.0, true, false}, "",
              "factor on the capillary time-step limit");

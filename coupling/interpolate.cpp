@@ -3,9 +3,11 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace meniscus::coupling {
 
@@ -50,23 +52,108 @@ double sample_component_bspline(const fluid::MacGrid& grid, int axis,
     return value;
 }
 
+/// Lower node of the linear-interpolation interval of lattice coordinate `s` (clamped into the
+/// lattice of `extent` nodes) and the fraction within it.
+std::pair<int, double> lattice_interval(double s, int extent) {
+    if (extent < 2)
+        return {0, 0.0};
+    const double clamped = std::clamp(s, 0.0, extent - 1.0);
+    const int lower = std::min(static_cast<int>(std::floor(clamped)), extent - 2);
+    return {lower, clamped - lower};
+}
+
+/// One-sided sample (VelocityInterpolation::one_sided) of velocity component `axis` at
+/// `grid_position` (cell units) for an interface with unit normal `n` there.
+double sample_component_one_sided(const fluid::MacGrid& grid, int axis,
+                                  const Eigen::Vector3d& grid_position, const Eigen::Vector3d& n) {
+    const fluid::Array3<double>& field = grid.velocity(axis);
+    const Eigen::Vector3d g = grid_position - fluid::field_offset(fluid::face_location(axis));
+    const std::array<int, 3> extent{field.ni(), field.nj(), field.nk()};
+    int a = 0;  // the column axis: the one closest to the normal
+    n.cwiseAbs().maxCoeff(&a);
+    const int b = (a + 1) % 3, e = (a + 2) % 3;
+    const auto [ib, fb] = lattice_interval(g[b], extent[static_cast<size_t>(b)]);
+    const auto [ie, fe] = lattice_interval(g[e], extent[static_cast<size_t>(e)]);
+    const int na = extent[static_cast<size_t>(a)];
+    double value = 0.0;
+    for (int cb = 0; cb < 2; ++cb) {
+        for (int ce = 0; ce < 2; ++ce) {
+            const double weight = (cb ? fb : 1.0 - fb) * (ce ? fe : 1.0 - fe);
+            if (weight == 0.0)
+                continue;
+            std::array<int, 3> node{};
+            node[static_cast<size_t>(b)] = std::min(ib + cb, extent[static_cast<size_t>(b)] - 1);
+            node[static_cast<size_t>(e)] = std::min(ie + ce, extent[static_cast<size_t>(e)] - 1);
+            // Where the tangent plane n·(p − x) = 0 crosses this column.
+            const double s = g[a] - (n[b] * (node[static_cast<size_t>(b)] - g[b]) +
+                                     n[e] * (node[static_cast<size_t>(e)] - g[e])) /
+                                        n[a];
+            const auto at = [&](int i) {
+                node[static_cast<size_t>(a)] = i;
+                return field(node[0], node[1], node[2]);
+            };
+            double column = 0.0;
+            if (na >= 4 && s >= 1.0 && s < na - 2.0) {
+                const int i0 = static_cast<int>(std::floor(s));
+                const double d = s - i0;
+                const double f0 = at(i0), f1 = at(i0 + 1);
+                const double below = f0 + d * (f0 - at(i0 - 1));
+                const double above = f1 + (1.0 - d) * (f1 - at(i0 + 2));
+                column = (1.0 - d) * below + d * above;
+            } else if (na >= 2) {  // near a wall: linear along the column (extrapolated past
+                                   // its ends, which keeps linear fields exact)
+                const int i0 = std::clamp(static_cast<int>(std::floor(s)), 0, na - 2);
+                const double d = s - i0;
+                column = (1.0 - d) * at(i0) + d * at(i0 + 1);
+            } else {
+                column = at(0);
+            }
+            value += weight * column;
+        }
+    }
+    return value;
+}
+
+/// Area-weighted vertex normals (zero for dead and isolated vertices).
+std::vector<Eigen::Vector3d> vertex_normals(const tracker::SurfaceMesh& mesh) {
+    std::vector<Eigen::Vector3d> normals(static_cast<size_t>(mesh.num_vertices()),
+                                         Eigen::Vector3d::Zero());
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti))
+            continue;
+        const tracker::Triangle& t = mesh.triangle(ti);
+        const Eigen::Vector3d area_normal = (mesh.position(t[1]) - mesh.position(t[0]))
+                                                .cross(mesh.position(t[2]) - mesh.position(t[0]));
+        for (int corner : t)
+            normals[static_cast<size_t>(corner)] += area_normal;
+    }
+    return normals;
+}
+
 }  // namespace
 
 void InterpolateOptions::validate() const {
     if (method != VelocityInterpolation::trilinear &&
-        method != VelocityInterpolation::quadratic_bspline)
-        throw std::invalid_argument("method: expected trilinear or quadratic_bspline");
+        method != VelocityInterpolation::quadratic_bspline &&
+        method != VelocityInterpolation::one_sided)
+        throw std::invalid_argument("method: expected trilinear, quadratic_bspline or one_sided");
 }
 
 Eigen::Vector3d sample_grid_velocity(const fluid::MacGrid& grid, const Eigen::Vector3d& x,
-                                     VelocityInterpolation method) {
+                                     VelocityInterpolation method, const Eigen::Vector3d& normal) {
     const Eigen::Vector3d g = grid.to_grid(x);
+    const double length = normal.norm();
+    const bool one_sided = method == VelocityInterpolation::one_sided && length > 0.0 &&
+                           std::isfinite(length);
     Eigen::Vector3d velocity;
     for (int axis = 0; axis < 3; ++axis) {
-        velocity[axis] =
-            method == VelocityInterpolation::quadratic_bspline
-                ? sample_component_bspline(grid, axis, g)
-                : fluid::interpolate_trilinear(grid.velocity(axis), fluid::face_location(axis), g);
+        if (one_sided)
+            velocity[axis] = sample_component_one_sided(grid, axis, g, normal / length);
+        else if (method == VelocityInterpolation::quadratic_bspline)
+            velocity[axis] = sample_component_bspline(grid, axis, g);
+        else
+            velocity[axis] =
+                fluid::interpolate_trilinear(grid.velocity(axis), fluid::face_location(axis), g);
     }
     return velocity;
 }
@@ -77,12 +164,18 @@ std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& g
     options.validate();
     std::vector<tracker::Vec3> velocities(static_cast<size_t>(mesh.num_vertices()),
                                           tracker::Vec3::Zero());
+    const std::vector<Eigen::Vector3d> normals =
+        options.method == VelocityInterpolation::one_sided ? vertex_normals(mesh)
+                                                           : std::vector<Eigen::Vector3d>{};
     tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_vertices()),
                       [&](const tbb::blocked_range<int>& range) {
                           for (int vi = range.begin(); vi != range.end(); ++vi)
                               if (mesh.vertex_alive(vi))
                                   velocities[static_cast<size_t>(vi)] =
-                                      sample_grid_velocity(grid, mesh.position(vi), options.method);
+                                      sample_grid_velocity(
+                                          grid, mesh.position(vi), options.method,
+                                          normals.empty() ? Eigen::Vector3d::Zero()
+                                                          : normals[static_cast<size_t>(vi)]);
                       });
     return velocities;
 }
