@@ -67,8 +67,13 @@ std::pair<int, double> lattice_interval(double s, int extent) {
 double sample_component_one_sided(const fluid::MacGrid& grid, int axis,
                                   const Eigen::Vector3d& grid_position, const Eigen::Vector3d& n) {
     const fluid::Array3<double>& field = grid.velocity(axis);
-    const Eigen::Vector3d g = grid_position - fluid::field_offset(fluid::face_location(axis));
     const std::array<int, 3> extent{field.ni(), field.nj(), field.nk()};
+    // Points outside the face lattice are clamped onto it, as trilinear sampling does: vertices
+    // far outside the domain (the cut ends of a wall-crossing column) must not see the columns
+    // extrapolated over many cells.
+    Eigen::Vector3d g = grid_position - fluid::field_offset(fluid::face_location(axis));
+    for (int d = 0; d < 3; ++d)
+        g[d] = std::clamp(g[d], 0.0, extent[static_cast<size_t>(d)] - 1.0);
     int a = 0;  // the column axis: the one closest to the normal
     n.cwiseAbs().maxCoeff(&a);
     const int b = (a + 1) % 3, e = (a + 2) % 3;

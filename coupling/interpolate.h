@@ -36,9 +36,10 @@ enum class VelocityInterpolation {
     /// Exact for linear fields and for fields linear on each side of a planar interface. The
     /// default: `meniscus validate` quick, against trilinear — Lamb's l = 2 frequency at 12 cells
     /// per diameter −4.9 % → −0.3 %, Rayleigh–Plateau growth at R = 3 cells −5.5 % → −0.7 %,
-    /// static-drop spurious currents +7 %. Where the 4-face column leaves the lattice (within
-    /// about one cell of a wall) it falls back to linear interpolation along the column,
-    /// extrapolated where the plane crosses the column beyond its end faces.
+    /// static-drop spurious currents +7 %. Points outside the face lattice are clamped onto it
+    /// (as trilinear); where the 4-face column leaves the lattice (within about one cell of a
+    /// wall) it falls back to linear interpolation along the column, extrapolated where the
+    /// tangent plane crosses the column beyond its end faces (at most about two face spacings).
     one_sided
 };
 
