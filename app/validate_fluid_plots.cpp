@@ -11,6 +11,7 @@ constexpr const char* PLOT_SCRIPT = R"PY(import json, math, os, sys
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+import matplotlib.ticker
 out = sys.argv[1]
 b = json.load(open(os.path.join(out, "results.json"))).get("part_b", {})
 
@@ -25,29 +26,56 @@ def save(fig, name):
     fig.savefig(os.path.join(out, name), dpi=120)
     plt.close(fig)
 
+def study_panel(ax, study, label, target):
+    """|error| against the reference per resolution, one line per dt factor (log-log)."""
+    factors = sorted({r["dt_factor"] for row in study["rows"] for r in row["runs"]}, reverse=True)
+    for f in factors:
+        xs, ys = [], []
+        for row in study["rows"]:
+            for r in row["runs"]:
+                if r["dt_factor"] == f:
+                    xs.append(row["resolution"])
+                    ys.append(max(abs(r["relative_error"]) * 100, 1e-3))
+        name = "own dt" if f == 1 else "dt/%g" % (1 / f)
+        ax.loglog(xs, ys, "o-", ms=4, label="%s, %s" % (study["quantity"], name))
+    ax.axhline(100 * target, color="k", ls=":", lw=1, label="target %g %%" % (100 * target))
+    ax.set_xticks([row["resolution"] for row in study["rows"]])
+    ax.xaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax.set_xlabel(label)
+    ax.set_ylabel("|error| (%)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+
+def run_label(r, resolution_key, unit):
+    f = r.get("dt_factor", 1)
+    return "%d %s%s" % (r[resolution_key], unit, "" if f == 1 else ", dt/%g" % (1 / f))
+
 if "B1" in b:
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.5))
     for r in b["B1"]["runs"]:
         s = r["series"]
         scale = b["B1"]["velocity_scale"]
         ax.semilogy([1e3 * t for t in s["t"]], [max(u / scale, 1e-12) for u in s["max_speed"]],
-                    label="%d cells per D" % r["cells_per_diameter"])
+                    label=run_label(r, "cells_per_diameter", "cells per D"))
     ax.set_xlabel("t (ms)")
     ax.set_ylabel("max|u| sqrt(rho D / sigma)")
     ax.set_title("B1 static drop: spurious currents")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
+    study_panel(bx, b["B1"]["jump"], "cells per diameter", 0.02)
+    bx.set_title("B1 pressure jump error against 2 sigma / R")
     save(fig, "b1_spurious.png")
 
 if "B2" in b:
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.5))
     w0 = b["B2"]["lamb_omega"]
     for r in b["B2"]["runs"]:
         s = r["series"]
         t = s["t"]
         d = s["deformation"]
         ax.plot([1e3 * x for x in t], [1e3 * y for y in d], ".", ms=2,
-                label="%d cells per D (measured)" % r["cells_per_diameter"])
+                label="%s (measured)" % run_label(r, "cells_per_diameter", "cells per D"))
         w = r["omega"]
         ax.plot([1e3 * x for x in t], [1e3 * y for y in damped_fit(r, t)],
                 "-", lw=1, label="fit: period %.2f ms" % (1e3 * 2 * math.pi / w))
@@ -60,47 +88,57 @@ if "B2" in b:
     ax.set_title("B2 oscillating drop (l = 2)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7)
+    study_panel(bx, b["B2"]["frequency"], "cells per diameter", 0.02)
+    bx.set_title("B2 frequency error against Lamb")
     save(fig, "b2_oscillation.png")
 
 if "B3" in b:
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.5))
     s0 = b["B3"]["theory_rate"]
     for r in b["B3"]["runs"]:
         s = r["series"]
         t = s["t"]
         R = b["B3"]["radius"]
         ax.semilogy([1e3 * x for x in t], [max(a / R, 1e-6) for a in s["amplitude"]], ".", ms=2,
-                    label="measured (%d cells per wavelength)" % r["cells_per_wavelength"])
+                    label="measured (%s)" % run_label(r, "cells_per_wavelength", "cells per wavelength"))
         tf = [x for x in t if x <= r["fit_t_end"]]
         ap, am, rate = r["fit_a_plus"], r["fit_a_minus"], r["rate"]
         ax.semilogy([1e3 * x for x in tf], [(ap * math.exp(rate * x) + am * math.exp(-rate * x)) / R for x in tf],
                     "-", label="fit: s = %.1f 1/s" % rate)
-        a0 = s["amplitude"][0]
-        ax.semilogy([1e3 * x for x in t], [a0 * math.cosh(s0 * x) / R for x in t], "k:",
-                    label="theory a0 cosh(st): s = %.1f 1/s" % s0)
+    r = max(b["B3"]["runs"], key=lambda r: r["t_end"])
+    t = r["series"]["t"]
+    a0 = r["series"]["amplitude"][0]
+    ax.semilogy([1e3 * x for x in t], [a0 * math.cosh(s0 * x) / R for x in t], "k:",
+                label="theory a0 cosh(st): s = %.1f 1/s" % s0)
     ax.set_ylim(1e-3, 2)
     ax.set_xlabel("t (ms)")
     ax.set_ylabel("amplitude / R")
     ax.set_title("B3 Rayleigh-Plateau: perturbation amplitude")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=6)
+    study_panel(bx, b["B3"]["growth"], "cells per wavelength", 0.05)
+    bx.set_title("B3 growth rate error against theory")
     save(fig, "b3_growth.png")
 
 if "B4" in b:
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.5))
     w0 = b["B4"]["omega0"]
     for r in b["B4"]["runs"]:
         s = r["series"]
         t = s["t"]
         a = s["amplitude"]
-        ax.plot(t, a, ".", ms=2, label="measured (%d cells per wavelength)" % r["cells_per_wavelength"])
+        ax.plot(t, a, ".", ms=2, label="measured (%s)" % run_label(r, "cells_per_wavelength", "cells per wavelength"))
         ax.plot(t, damped_fit(r, t), "-", lw=1, label="fit: omega = %.3f" % r["omega"])
-        ax.plot(t, [a[0] * math.cos(w0 * x) for x in t], "k:", lw=1, label="inviscid: omega0 = %.3f" % w0)
+    r = b["B4"]["runs"][-1]
+    t, a = r["series"]["t"], r["series"]["amplitude"]
+    ax.plot(t, [a[0] * math.cos(w0 * x) for x in t], "k:", lw=1, label="inviscid: omega0 = %.3f" % w0)
     ax.set_xlabel("t")
     ax.set_ylabel("amplitude of cos(kx)")
     ax.set_title("B4 capillary wave")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=6)
+    study_panel(bx, b["B4"]["frequency"], "cells per wavelength", 0.02)
+    bx.set_title("B4 frequency error")
     save(fig, "b4_wave.png")
 
 if "B5" in b:
@@ -118,24 +156,6 @@ if "B5" in b:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     save(fig, "b5_volume.png")
-
-def study_panel(ax, study, label, target):
-    """|error| against the reference per resolution, one line per dt factor (log-log)."""
-    factors = sorted({r["dt_factor"] for row in study["rows"] for r in row["runs"]}, reverse=True)
-    for f in factors:
-        xs, ys = [], []
-        for row in study["rows"]:
-            for r in row["runs"]:
-                if r["dt_factor"] == f:
-                    xs.append(row["resolution"])
-                    ys.append(max(abs(r["relative_error"]) * 100, 1e-3))
-        name = "own dt" if f == 1 else "dt/%g" % (1 / f)
-        ax.loglog(xs, ys, "o-", ms=4, label="%s, %s" % (study["quantity"], name))
-    ax.axhline(100 * target, color="k", ls=":", lw=1, label="target %g %%" % (100 * target))
-    ax.set_xlabel(label)
-    ax.set_ylabel("|error| (%)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
 
 if "B6" in b:
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.5))

@@ -35,7 +35,7 @@ enum class VelocityInterpolation {
     /// crossing's fraction of the face spacing); the four column values are blended bilinearly.
     /// Exact for linear fields and for fields linear on each side of a planar interface. The
     /// default: `meniscus validate` quick, against trilinear — Lamb's l = 2 frequency at 12 cells
-    /// per diameter −4.9 % → −0.3 %, Rayleigh–Plateau growth at R = 3 cells −5.5 % → −0.7 %,
+    /// per diameter −4.9 % → −0.3 %, Rayleigh–Plateau growth at R = 3 cells −5.5 % → −0.6 %,
     /// static-drop spurious currents +7 %. Points outside the face lattice are clamped onto it
     /// (as trilinear); where the 4-face column leaves the lattice (within about one cell of a
     /// wall) it falls back to linear interpolation along the column, extrapolated where the
