@@ -143,9 +143,7 @@ struct Runner : CaseContext {
                 check(what, r);
                 study.add(cpd, dx,
                           {factor, r.first_dt, jump.back(), laplace, r.steps, r.wall_seconds});
-                double peak_speed = 0.0;
-                for (double u : r.max_speed)
-                    peak_speed = std::max(peak_speed, u);
+                const double peak_speed = series_peak(r.max_speed);
                 const double scale = std::sqrt(RHO_L * diameter / SIGMA);
                 Json run = run_summary(r);
                 run.update({{"cells_per_diameter", cpd},
@@ -248,17 +246,10 @@ struct Runner : CaseContext {
                             {"dt_factor", factor},
                             {"dt", r.first_dt},
                             {"dx", box / cells},
-                            {"omega", fit.omega},
                             {"period", 2.0 * M_PI / fit.omega},
-                            {"decay_rate", fit.decay_rate},
-                            {"amplitude", fit.amplitude},
-                            {"cos_coefficient", fit.cos_coefficient},
-                            {"sin_coefficient", fit.sin_coefficient},
-                            {"offset", fit.offset},
-                            {"rms_residual", fit.rms_residual},
-                            {"frequency_relative_error", fit.omega / omega - 1.0},
                             {"volume_drift", max_relative_drift(r.enclosed_volume)},
                             {"series", series_json(r)}});
+                run.update(oscillation_fit_json(fit, omega));
                 run["series"]["deformation"] = deformation;
                 log(what + ": period " + fmt(1e3 * 2.0 * M_PI / fit.omega) + " ms (Lamb " +
                     fmt(1e3 * period) + "), " + fmt(r.wall_seconds, "%.0f") + " s");
@@ -508,21 +499,12 @@ struct Runner : CaseContext {
                 run.update({{"cells_per_wavelength", cells},
                             {"dt_factor", factor},
                             {"dt", r.first_dt},
-                            {"omega", fit.omega},
-                            {"decay_rate", fit.decay_rate},
-                            {"amplitude", fit.amplitude},
-                            {"cos_coefficient", fit.cos_coefficient},
-                            {"sin_coefficient", fit.sin_coefficient},
-                            {"offset", fit.offset},
-                            {"rms_residual", fit.rms_residual},
-                            {"frequency_relative_error", fit.omega / omega - 1.0},
                             {"volume_drift", max_relative_drift(r.enclosed_volume)},
                             {"series", series_json(r)}});
+                run.update(oscillation_fit_json(fit, omega));
                 run["series"]["amplitude"] = a;
                 // The flow's own velocity scale is a₀ω₀; a max|u| far above it is a spurious flow.
-                double peak_speed = 0.0;
-                for (double u : r.max_speed)
-                    peak_speed = std::max(peak_speed, u);
+                const double peak_speed = series_peak(r.max_speed);
                 run["peak_speed_over_a0_omega0"] = peak_speed / (amplitude0 * omega);
                 run["final_speed_over_a0_omega0"] = r.max_speed.back() / (amplitude0 * omega);
                 log(what + ": ω " + fmt(fit.omega) + " (ω₀ " + fmt(omega) + "), " +

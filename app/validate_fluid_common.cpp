@@ -51,6 +51,24 @@ double max_relative_drift(const std::vector<double>& v) {
     return drift;
 }
 
+double series_peak(const std::vector<double>& v) {
+    double peak = 0.0;
+    for (double x : v)
+        peak = std::max(peak, x);
+    return peak;
+}
+
+Json oscillation_fit_json(const OscillationFit& fit, double omega_reference) {
+    return {{"omega", fit.omega},
+            {"decay_rate", fit.decay_rate},
+            {"amplitude", fit.amplitude},
+            {"cos_coefficient", fit.cos_coefficient},
+            {"sin_coefficient", fit.sin_coefficient},
+            {"offset", fit.offset},
+            {"rms_residual", fit.rms_residual},
+            {"frequency_relative_error", fit.omega / omega_reference - 1.0}};
+}
+
 void CaseContext::log(const std::string& line) const {
     if (!options.quiet)
         std::fprintf(stderr, "  %s\n", line.c_str());

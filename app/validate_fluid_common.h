@@ -36,6 +36,11 @@ Json series_json(const FluidRunRecord& r);
 Json run_summary(const FluidRunRecord& r);
 /// Largest |v/v₀ − 1| over a series.
 double max_relative_drift(const std::vector<double>& v);
+/// Largest value of a series (0 when empty).
+double series_peak(const std::vector<double>& v);
+/// The fields of a damped-oscillation fit (ω, γ, the coefficients, the rms residual) for a
+/// run's JSON, with the frequency's relative error against `omega_reference`.
+Json oscillation_fit_json(const OscillationFit& fit, double omega_reference);
 
 /// Shared state of the cases: options, the output, and what failed.
 struct CaseContext {

@@ -109,15 +109,9 @@ void viscous_drop_case(CaseContext& context, std::ostringstream& md) {
             run.update({{"cells_per_diameter", cpd},
                         {"dt_factor", factor},
                         {"dt", r.first_dt},
-                        {"omega", fit.omega},
-                        {"decay_rate", fit.decay_rate},
-                        {"offset", fit.offset},
-                        {"cos_coefficient", fit.cos_coefficient},
-                        {"sin_coefficient", fit.sin_coefficient},
-                        {"amplitude", fit.amplitude},
-                        {"rms_residual", fit.rms_residual},
                         {"volume_drift", max_relative_drift(r.enclosed_volume)},
                         {"series", series_json(r)}});
+            run.update(oscillation_fit_json(fit, mode.omega));
             run["series"]["deformation"] = deformation;
             runs.push_back(run);
             context.log(what + ": ω " + fmt(fit.omega) + " (exact " + fmt(mode.omega) + "), γ " +
