@@ -352,10 +352,12 @@ struct Runner : CaseContext {
                                          factor_text(factor);
                 check(what, r);
                 // The linear regime: from the start while the amplitude stays below 0.1 R, one
-                // component.
+                // component, and the same window for every run (the one that goes on to
+                // pinch-off too), so that the rows compare.
                 std::vector<double> t_lin, a_lin;
                 for (size_t i = 0; i < r.t.size(); ++i) {
-                    if (amplitude[i] > LINEAR_AMPLITUDE_FRACTION * JET_R || r.components[i] != 1)
+                    if (amplitude[i] > LINEAR_AMPLITUDE_FRACTION * JET_R || r.components[i] != 1 ||
+                        r.t[i] > linear_end * (1.0 + 1e-9))
                         break;
                     t_lin.push_back(r.t[i]);
                     a_lin.push_back(amplitude[i]);
@@ -410,7 +412,8 @@ struct Runner : CaseContext {
               "bulges at the walls, the neck in the middle). Amplitude a(t): least-squares "
               "cos(kx) mode of the vertices' distance to the axis. Fitted, while a < 0.1R and "
               "the column is whole, to A e^{st} + B e^{−st} (the linear solution from rest; "
-              "relative least squares). Inviscid theory: s² = σ/(ρR³)·x(1−x²)I₁(x)/I₀(x), s = "
+              "relative least squares) up to " << fmt(1e3 * linear_end, "%.3g")
+           << " ms in every run. Inviscid theory: s² = σ/(ρR³)·x(1−x²)I₁(x)/I₀(x), s = "
            << fmt(rate, "%.4g") << " 1/s. Runs end at " << fmt(1e3 * linear_end, "%.3g")
            << " ms (the linear regime)"
            << (options.full ? ", the 36-cell run at the solver's Δt at 30 ms (pinch-off)" : "")
