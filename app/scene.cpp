@@ -134,7 +134,7 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
                               {"v_cycle", fluid::SchurPreconditioner::v_cycle}},
                              "coupled: the Cahouet–Chabard preconditioner's inverse pressure "
                              "Laplacian, a full `poisson_solve` or one multigrid `v_cycle` "
-                             "(multigrid_pcg only; experimental)");
+                             "(multigrid_pcg only)");
                   r.integer("max_passes", o.viscous_pressure.max_passes, Range::between(1, 100),
                             "", "coupled: most viscous + pressure passes per step");
                   r.number("pass_tolerance", o.viscous_pressure.pass_tolerance,

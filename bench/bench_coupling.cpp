@@ -10,7 +10,7 @@
 // each other as in bubble_merge, with T TBB threads (tbb::global_control). One untimed step
 // first (it builds the first pressure and the solver's workspaces), then
 // MENISCUS_BENCH_CUBE_STEPS timed steps (default 3); MENISCUS_BENCH_SCHUR sets
-// /fluid/viscous_pressure/preconditioner (default poisson_solve).
+// /fluid/viscous_pressure/preconditioner (default v_cycle, as scenes).
 //
 // Counters: <phase>_cpu_us and <phase>_wall_us, µs per cell per step, for the coupling's phases
 // (rasterize, curvature, fluid, interpolate, volume_correction, tracker), the fluid step's
@@ -66,7 +66,7 @@ app::Scene refined_scene(const std::string& name, int cells) {
 /// Two bubbles of radius 1.5 mm, 0.3 mm apart, in water in a 1 cm cube of `cells`³ cells.
 app::Scene bubble_pair_cube(int cells) {
     const char* schur_env = std::getenv("MENISCUS_BENCH_SCHUR");
-    const std::string schur = schur_env != nullptr ? schur_env : "poisson_solve";
+    const std::string schur = schur_env != nullptr ? schur_env : "v_cycle";
     const std::string json = R"({
       "name": "bench_bubble_pair_cube",
       "flow": {"type": "fluid"},

@@ -53,13 +53,16 @@ enum class ViscousPressureCoupling { split, incremental, coupled };
 enum class SchurPreconditioner {
     poisson_solve,  ///< a full PCG solve to the pressure tolerance
     /// one multigrid V-cycle (a fixed symmetric operator, so the Uzawa–PCG stays a plain PCG;
-    /// other pressure backends fall back to poisson_solve)
+    /// other pressure backends fall back to poisson_solve). The default: the passes converge to
+    /// the same coupled step in more, much cheaper passes — `validate` B6 and B7 quick give the
+    /// same ω, γ and rise speed to 4 digits in 13 s instead of 42 s (B6 at Δt); at 128³ (bubble
+    /// pair, 1 thread) the pressure solve costs 2.8 instead of 7.1 µs per cell per step.
     v_cycle
 };
 
 struct ViscousPressureOptions {
     ViscousPressureCoupling coupling = ViscousPressureCoupling::coupled;
-    SchurPreconditioner preconditioner = SchurPreconditioner::poisson_solve;
+    SchurPreconditioner preconditioner = SchurPreconditioner::v_cycle;
     /// coupled: the most Uzawa–PCG iterations per step (each one viscous and one pressure
     /// solve; ≥ 1).
     int max_passes = 8;
