@@ -420,7 +420,7 @@ TEST_F(QuickValidation, PartBMergeSceneKeepsPhaseVolumes) {
     }
     for (const char* heading : {"## B1", "## B2", "## B3", "## B4", "## B5"})
         EXPECT_NE(s_report.find(heading), std::string::npos) << heading;
-    EXPECT_NE(s_report.find("| cells per D | steps | fitted period (ms) | Lamb (ms)"),
+    EXPECT_NE(s_report.find("| cells per D | Δt | steps | fitted period (ms) | Lamb (ms)"),
               std::string::npos);
 }
 
