@@ -17,6 +17,10 @@ std::string percent(double measured, double reference) {
     return fmt(100.0 * (measured / reference - 1.0), "%+.2f %%");
 }
 
+std::string dt_factor_text(double factor) {
+    return factor == 1.0 ? std::string("Δt") : "Δt/" + fmt(1.0 / factor, "%.3g");
+}
+
 Json base_scene(const std::string& name) {
     return {{"name", name},
             {"flow", {{"type", "fluid"}}},
@@ -156,14 +160,11 @@ std::string study_markdown(const Study& study, const std::string& resolution_lab
             for (const StudyRun& r : row.runs)
                 factors.push_back(r.dt_factor);
         }
-    const auto factor_name = [](double f) {
-        return f == 1.0 ? std::string("Δt") : "Δt/" + fmt(1.0 / f, "%.3g");
-    };
     std::ostringstream md;
     md << "| " << resolution_label << " | Δx (m) | Δt (s) | steps | " << study.quantity << " ("
        << study.unit << ") | reference |";
     for (double f : factors)
-        md << " error at " << factor_name(f) << " |";
+        md << " error at " << dt_factor_text(f) << " |";
     md << " order in Δx | order in Δt | target |\n|---|---|---|---|---|---|";
     for (size_t i = 0; i < factors.size(); ++i)
         md << "---|";

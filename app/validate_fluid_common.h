@@ -23,6 +23,8 @@ using Json = nlohmann::json;
 std::string fmt(double v, const char* f = "%.4g");
 /// 100 (measured/reference − 1) as "+1.23 %".
 std::string percent(double measured, double reference);
+/// A time-step factor as the report names it: "Δt" for 1, "Δt/2" for ½, …
+std::string dt_factor_text(double factor);
 
 /// A fluid scene JSON with the validation defaults: two_phase, no gravity, one cell per edge,
 /// volume correction on, no PLY/VDB output.
