@@ -1,5 +1,7 @@
 #include "coupling/interpolate.h"
 
+#include "tracker/mesh_measures.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -119,22 +121,6 @@ double sample_component_one_sided(const fluid::MacGrid& grid, int axis,
     return value;
 }
 
-/// Area-weighted vertex normals (zero for dead and isolated vertices).
-std::vector<Eigen::Vector3d> vertex_normals(const tracker::SurfaceMesh& mesh) {
-    std::vector<Eigen::Vector3d> normals(static_cast<size_t>(mesh.num_vertices()),
-                                         Eigen::Vector3d::Zero());
-    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
-        if (!mesh.triangle_alive(ti))
-            continue;
-        const tracker::Triangle& t = mesh.triangle(ti);
-        const Eigen::Vector3d area_normal = (mesh.position(t[1]) - mesh.position(t[0]))
-                                                .cross(mesh.position(t[2]) - mesh.position(t[0]));
-        for (int corner : t)
-            normals[static_cast<size_t>(corner)] += area_normal;
-    }
-    return normals;
-}
-
 }  // namespace
 
 void InterpolateOptions::validate() const {
@@ -148,8 +134,8 @@ Eigen::Vector3d sample_grid_velocity(const fluid::MacGrid& grid, const Eigen::Ve
                                      VelocityInterpolation method, const Eigen::Vector3d& normal) {
     const Eigen::Vector3d g = grid.to_grid(x);
     const double length = normal.norm();
-    const bool one_sided = method == VelocityInterpolation::one_sided && length > 0.0 &&
-                           std::isfinite(length);
+    const bool one_sided =
+        method == VelocityInterpolation::one_sided && length > 0.0 && std::isfinite(length);
     Eigen::Vector3d velocity;
     for (int axis = 0; axis < 3; ++axis) {
         if (one_sided)
@@ -169,19 +155,18 @@ std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& g
     options.validate();
     std::vector<tracker::Vec3> velocities(static_cast<size_t>(mesh.num_vertices()),
                                           tracker::Vec3::Zero());
-    const std::vector<Eigen::Vector3d> normals =
-        options.method == VelocityInterpolation::one_sided ? vertex_normals(mesh)
-                                                           : std::vector<Eigen::Vector3d>{};
-    tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_vertices()),
-                      [&](const tbb::blocked_range<int>& range) {
-                          for (int vi = range.begin(); vi != range.end(); ++vi)
-                              if (mesh.vertex_alive(vi))
-                                  velocities[static_cast<size_t>(vi)] =
-                                      sample_grid_velocity(
-                                          grid, mesh.position(vi), options.method,
-                                          normals.empty() ? Eigen::Vector3d::Zero()
-                                                          : normals[static_cast<size_t>(vi)]);
-                      });
+    const std::vector<tracker::Vec3> normals = options.method == VelocityInterpolation::one_sided
+                                                   ? tracker::area_weighted_vertex_normals(mesh)
+                                                   : std::vector<tracker::Vec3>{};
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, mesh.num_vertices()), [&](const tbb::blocked_range<int>& range) {
+            for (int vi = range.begin(); vi != range.end(); ++vi)
+                if (mesh.vertex_alive(vi))
+                    velocities[static_cast<size_t>(vi)] =
+                        sample_grid_velocity(grid, mesh.position(vi), options.method,
+                                             normals.empty() ? Eigen::Vector3d::Zero()
+                                                             : normals[static_cast<size_t>(vi)]);
+        });
     return velocities;
 }
 

@@ -57,7 +57,7 @@ Eigen::Vector3d sample_grid_velocity(const fluid::MacGrid& grid, const Eigen::Ve
                                      const Eigen::Vector3d& normal = Eigen::Vector3d::Zero());
 
 /// Velocity (m/s) at every vertex of `mesh`, sized num_vertices(); zero for dead vertices.
-/// `one_sided` takes each vertex's normal as the area-weighted sum of its triangles' normals.
+/// `one_sided` takes each vertex's normal from tracker::area_weighted_vertex_normals().
 /// Parallel over vertices (TBB). Throws std::invalid_argument on invalid options.
 std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& grid,
                                                          const tracker::SurfaceMesh& mesh,
