@@ -205,6 +205,42 @@ void BM_ChangeTopology(benchmark::State& state) {
     state.counters["separate_s"] = report.separation.seconds;
 }
 
+/// The topology phase of a step in which nothing merges or pinches (the common case): one
+/// sphere, nothing within the merge distance; then compaction, as SurfaceTracker does.
+void BM_ChangeTopologyQuiet(benchmark::State& state) {
+    const SurfaceMesh base = sphere_mesh(static_cast<int>(state.range(0)), RADIUS, Vec3::Zero());
+    meniscus::tracker::TopologyOptions options;
+    meniscus::tracker::TopologyContext context;
+    context.xi = meniscus::tracker::edge_length_stats(base).mean;
+    meniscus::tracker::TopologyReport report;
+    SurfaceMesh mesh = base;
+    for (auto _ : state) {
+        report = meniscus::tracker::change_topology(mesh, options, context);
+        benchmark::DoNotOptimize(mesh);
+    }
+    state.counters["triangles"] = base.count_live_triangles();
+    state.counters["merge_s"] = report.merge.seconds;
+    state.counters["separate_s"] = report.separation.seconds;
+}
+
+/// SurfaceMesh::compact() after a tenth of the edges were split (dead slots to remove).
+void BM_Compact(benchmark::State& state) {
+    SurfaceMesh base = sphere_mesh(static_cast<int>(state.range(0)), RADIUS, Vec3::Zero());
+    for (int ei = 0, n = base.num_edges(); ei < n; ei += 10)
+        if (base.edge_alive(ei)) {
+            const auto e = base.edge(ei);
+            base.split_edge(ei, 0.5 * (base.position(e[0]) + base.position(e[1])));
+        }
+    for (auto _ : state) {
+        state.PauseTiming();
+        SurfaceMesh mesh = base;
+        state.ResumeTiming();
+        mesh.compact();
+        benchmark::DoNotOptimize(mesh);
+    }
+    state.counters["triangles"] = base.count_live_triangles();
+}
+
 /// Outer sphere of radius RADIUS and, a quarter of an α-chord's sag inside it, a copy scaled
 /// down with its orientation reversed; half the triangles each.
 const SurfaceMesh& thin_shell(int triangles, double& xi) {
@@ -257,6 +293,8 @@ BENCHMARK(BM_ImproveMeshSteadyState)
     ->Arg(200000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ChangeTopology)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ChangeTopologyQuiet)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Compact)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ThinSheetSizing)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
 
 }  // namespace

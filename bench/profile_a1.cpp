@@ -117,6 +117,8 @@ int main(int argc, char** argv) {
 
     PhaseTimer improve, topology, velocity, collisions;
     double smooth = 0, split = 0, flip = 0, collapse = 0;
+    double merge = 0, separate = 0, compact = 0, quiet_topology = 0;
+    long quiet_steps = 0;  // steps whose topology phase changed nothing
     int min_tris = mesh.count_live_triangles(), max_tris = min_tris;
     double t = 0.0;
     long steps = 0;
@@ -132,8 +134,17 @@ int main(int argc, char** argv) {
         flip += ir.flip.seconds;
         collapse += ir.collapse.seconds;
         topology.start();
-        tracker.change_topology();
+        const double topology_wall = topology.wall;
+        const TopologyReport tr = tracker.change_topology();
         topology.stop();
+        merge += tr.merge.seconds;
+        separate += tr.separation.seconds;
+        compact += (topology.wall - topology_wall) - tr.seconds;
+        if (tr.merge.merges == 0 && tr.separation.singular_vertices_split == 0 &&
+            tr.separation.degenerate_tetrahedra_removed == 0) {
+            quiet_topology += topology.wall - topology_wall;
+            ++quiet_steps;
+        }
         velocity.start();
         const FlowStep step = stepper.step(mesh, t, offered);
         std::vector<Vec3> v(step.displacements.size());
@@ -165,6 +176,9 @@ int main(int argc, char** argv) {
                 (improve.cpu + topology.cpu + velocity.cpu + collisions.cpu) / n);
     std::printf("improve parts, wall per step (s): smooth %.4f  split %.4f  flip %.4f  collapse %.4f\n",
                 smooth / n, split / n, flip / n, collapse / n);
+    std::printf("topology parts, wall per step (s): merge %.4f  separate %.4f  compact "
+                "%.4f; on the %ld steps without a change %.4f\n",
+                merge / n, separate / n, compact / n, quiet_steps, quiet_topology / std::max(quiet_steps, 1L));
     std::printf("wall %.2f s, process CPU %.2f s (%.2f s/step)\n", wall, cpu, cpu / n);
     std::printf("intersecting pairs at end: %zu\n", find_self_intersections(mesh).triangle_pairs.size());
     std::printf("final mesh hash: %016llx\n", static_cast<unsigned long long>(mesh_hash(mesh)));

@@ -602,6 +602,22 @@ std::vector<TrianglePair> BroadPhase::triangle_pairs() const {
     });
 }
 
+std::vector<EdgeEdgePair> static_edge_edge_pairs(const SurfaceMesh& mesh, double padding,
+                                                 const std::function<bool(int, int)>& keep) {
+    const std::vector<Vec3>& x = mesh.positions();
+    check_sizes(mesh, x, x, padding);
+    const std::vector<Box3d> boxes = boxes_of(mesh.num_edges(), [&](int ei, Box3d& b) {
+        if (mesh.edge_alive(ei))
+            b = edge_box(x, x, mesh.edge(ei), padding);
+    });
+    const LooseGrid grid(boxes);
+    return self_join<EdgeEdgePair>(grid, [&](int ei, int ej, std::vector<EdgeEdgePair>& out) {
+        const int a = std::min(ei, ej), b = std::max(ei, ej);
+        if (!shares_vertex(mesh.edge(a), mesh.edge(b)) && keep(a, b))
+            out.push_back({a, b});
+    });
+}
+
 std::vector<VertexTrianglePair> brute_force_vertex_triangle_pairs(const SurfaceMesh& mesh,
                                                                   const std::vector<Vec3>& x_t0,
                                                                   const std::vector<Vec3>& x_t1,

@@ -16,6 +16,7 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace meniscus::tracker {
@@ -169,6 +170,14 @@ private:
     std::vector<Box3d> m_vertex_boxes, m_edge_boxes, m_triangle_boxes;
     LooseGrid m_edges, m_triangles;
 };
+
+/// Edge–edge pairs of the mesh at rest (no shared vertex, ei < ej, sorted) whose boxes, padded
+/// by `padding` ≥ 0, overlap and which `keep(ei, ej)` accepts — for callers that test every
+/// candidate at once (merging): only edge boxes are built, and the test runs inside the
+/// parallel join instead of on a list of every overlapping pair. `keep` may be called from
+/// several threads at once. Throws std::invalid_argument on negative padding.
+std::vector<EdgeEdgePair> static_edge_edge_pairs(const SurfaceMesh& mesh, double padding,
+                                                 const std::function<bool(int, int)>& keep);
 
 /// Box of points moving linearly from p_t0[i] to p_t1[i], padded by `padding`.
 Box3d swept_box(std::initializer_list<const Vec3*> p_t0, std::initializer_list<const Vec3*> p_t1,

@@ -2,6 +2,8 @@
 
 #include "common/assert.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
@@ -340,34 +342,95 @@ int SurfaceMesh::duplicate_vertex(int vi, const std::vector<int>& triangles,
 }
 
 std::vector<int> SurfaceMesh::compact() {
+    // The result is exactly the mesh SurfaceMesh(live positions, live triangles, labels) would
+    // build — edges numbered in order of first appearance around the live triangles, every
+    // adjacency list in increasing index order — but renumbered in place: no edge lookups, no
+    // reallocation of the adjacency lists.
     std::vector<int> vertex_map(m_positions.size(), INVALID_INDEX);
     int nv = 0;
     for (size_t vi = 0; vi < m_positions.size(); ++vi)
         if (m_vertex_alive[vi])
             vertex_map[vi] = nv++;
-
-    std::vector<Vec3> positions;
-    positions.reserve(static_cast<size_t>(nv));
-    for (size_t vi = 0; vi < m_positions.size(); ++vi)
-        if (m_vertex_alive[vi])
-            positions.push_back(m_positions[vi]);
-
-    std::vector<Triangle> triangles;
-    std::vector<LabelPair> labels;
-    triangles.reserve(m_triangles.size());
-    labels.reserve(m_triangles.size());
+    std::vector<int> triangle_map(m_triangles.size(), INVALID_INDEX);
+    std::vector<int> edge_map(m_edges.size(), INVALID_INDEX);
+    int nt = 0, ne = 0;
     for (size_t ti = 0; ti < m_triangles.size(); ++ti) {
-        const Triangle& t = m_triangles[ti];
-        if (t[0] < 0)
+        if (m_triangles[ti][0] < 0)
             continue;
-        triangles.push_back({vertex_map[static_cast<size_t>(t[0])],
-                             vertex_map[static_cast<size_t>(t[1])],
-                             vertex_map[static_cast<size_t>(t[2])]});
-        labels.push_back(m_labels[ti]);
+        triangle_map[ti] = nt++;
+        for (int ei : m_triangle_edges[ti])
+            if (edge_map[static_cast<size_t>(ei)] == INVALID_INDEX)
+                edge_map[static_cast<size_t>(ei)] = ne++;
     }
-    std::vector<MeshObserver*> observers = std::move(m_observers);
-    *this = SurfaceMesh(std::move(positions), triangles, labels);
-    m_observers = std::move(observers);
+    const auto remap_sorted = [](std::vector<int>& list, const std::vector<int>& map) {
+        size_t kept = 0;
+        for (int old : list) {
+            const int now = map[static_cast<size_t>(old)];
+            if (now != INVALID_INDEX)
+                list[kept++] = now;
+        }
+        list.resize(kept);
+        std::sort(list.begin(), list.end());
+    };
+
+    // Vertices (the maps are increasing, so an element's new index never exceeds its old one
+    // and moving forward in place is safe).
+    for (size_t vi = 0; vi < m_positions.size(); ++vi) {
+        const int now = vertex_map[vi];
+        if (now == INVALID_INDEX)
+            continue;
+        const size_t n = static_cast<size_t>(now);
+        m_positions[n] = m_positions[vi];
+        if (n != vi) {
+            m_vertex_triangles[n] = std::move(m_vertex_triangles[vi]);
+            m_vertex_edges[n] = std::move(m_vertex_edges[vi]);
+        }
+    }
+    m_positions.resize(static_cast<size_t>(nv));
+    m_vertex_alive.assign(static_cast<size_t>(nv), 1);
+    m_vertex_triangles.resize(static_cast<size_t>(nv));
+    m_vertex_edges.resize(static_cast<size_t>(nv));
+    tbb::parallel_for(0, nv, [&](int vi) {
+        remap_sorted(m_vertex_triangles[static_cast<size_t>(vi)], triangle_map);
+        remap_sorted(m_vertex_edges[static_cast<size_t>(vi)], edge_map);
+    });
+
+    // Triangles.
+    for (size_t ti = 0; ti < triangle_map.size(); ++ti) {
+        const int now = triangle_map[ti];
+        if (now == INVALID_INDEX)
+            continue;
+        const size_t n = static_cast<size_t>(now);
+        const Triangle t = m_triangles[ti];
+        const std::array<int, 3> e = m_triangle_edges[ti];
+        for (size_t k = 0; k < 3; ++k) {
+            m_triangles[n][k] = vertex_map[static_cast<size_t>(t[k])];
+            m_triangle_edges[n][k] = edge_map[static_cast<size_t>(e[k])];
+        }
+        m_labels[n] = m_labels[ti];
+    }
+    m_triangles.resize(static_cast<size_t>(nt));
+    m_triangle_edges.resize(static_cast<size_t>(nt));
+    m_labels.resize(static_cast<size_t>(nt));
+
+    // Edges: new order is first appearance, not old order, so permute through scratch.
+    std::vector<Edge> edges(static_cast<size_t>(ne));
+    std::vector<std::vector<int>> edge_triangles(static_cast<size_t>(ne));
+    for (size_t ei = 0; ei < edge_map.size(); ++ei) {
+        const int now = edge_map[ei];
+        if (now == INVALID_INDEX)
+            continue;
+        const size_t n = static_cast<size_t>(now);
+        edges[n] = {vertex_map[static_cast<size_t>(m_edges[ei][0])],
+                    vertex_map[static_cast<size_t>(m_edges[ei][1])]};
+        edge_triangles[n] = std::move(m_edge_triangles[ei]);
+    }
+    tbb::parallel_for(0, ne, [&](int ei) {
+        remap_sorted(edge_triangles[static_cast<size_t>(ei)], triangle_map);
+    });
+    m_edges = std::move(edges);
+    m_edge_triangles = std::move(edge_triangles);
+
     for (MeshObserver* o : m_observers)
         o->on_compact(vertex_map);
     return vertex_map;

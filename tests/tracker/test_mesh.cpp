@@ -110,6 +110,92 @@ TEST(SurfaceMesh, CollapseAndCompactNotifyObservers) {
     EXPECT_TRUE(validate_mesh(m).empty());
 }
 
+TEST(SurfaceMesh, CompactEqualsRebuildingFromTheLiveElements) {
+    // compact() renumbers in place; what it leaves must be exactly the mesh that the
+    // constructor builds from the live positions, triangles and labels (edge numbering,
+    // adjacency order and all), so that every later operation behaves as it did when compact()
+    // was that rebuild. The octahedron is split, flipped and collapsed into a mesh with dead
+    // vertices, triangles and edges and unsorted adjacency lists (removals swap with the back).
+    SurfaceMesh m = octahedron();
+    for (int round = 0; round < 6; ++round) {
+        for (int ei = 0, n = m.num_edges(); ei < n; ei += 3)
+            if (m.edge_alive(ei)) {
+                const Edge e = m.edge(ei);
+                // On the unit sphere, where no three vertices are collinear.
+                m.split_edge(ei, (m.position(e[0]) + m.position(e[1])).normalized());
+            }
+        for (int ei = m.num_edges() - 1; ei >= 0; ei -= 5)
+            if (m.edge_alive(ei) && m.edge_triangles(ei).size() == 2) {
+                const auto& et = m.edge_triangles(ei);
+                const int t0 = m.edge_orientation_in_triangle(et[0], ei) == 1 ? et[0] : et[1];
+                const int t1 = t0 == et[0] ? et[1] : et[0];
+                const Edge e = m.edge(ei);
+                // Flip only where the other diagonal is not an edge already.
+                if (m.find_edge(m.opposite_vertex(t0, ei), m.opposite_vertex(t1, ei)) ==
+                        INVALID_INDEX &&
+                    e[0] != e[1])
+                    m.flip_edge(ei, t0, t1);
+            }
+        for (int ei = 0; ei < m.num_edges(); ei += 7)
+            if (m.edge_alive(ei) && m.vertex_triangles(m.edge(ei)[1]).size() >= 5 &&
+                m.vertex_triangles(m.edge(ei)[0]).size() >= 5) {
+                const Edge e = m.edge(ei);
+                // Only where the collapse keeps the mesh a manifold (the link condition).
+                int common = 0;
+                for (int a : m.vertex_edges(e[0]))
+                    for (int b : m.vertex_edges(e[1]))
+                        common += m.other_vertex(a, e[0]) == m.other_vertex(b, e[1]) ? 1 : 0;
+                if (common == 2)
+                    m.collapse_edge(ei, e[0], (m.position(e[0]) + m.position(e[1])).normalized(),
+                                    0.5);
+            }
+    }
+    ASSERT_TRUE(m.has_dead_elements());
+    ValidationOptions connectivity_only;  // the positions are not the point here
+    connectivity_only.check_degenerate_area = false;
+    ASSERT_TRUE(validate_mesh(m, connectivity_only).empty());
+    std::vector<Vec3> positions;
+    for (int vi = 0; vi < m.num_vertices(); ++vi)
+        if (m.vertex_alive(vi))
+            positions.push_back(m.position(vi));
+    std::vector<int> map(static_cast<size_t>(m.num_vertices()), INVALID_INDEX);
+    for (int vi = 0, next = 0; vi < m.num_vertices(); ++vi)
+        if (m.vertex_alive(vi))
+            map[static_cast<size_t>(vi)] = next++;
+    std::vector<Triangle> triangles;
+    std::vector<LabelPair> labels;
+    for (int ti = 0; ti < m.num_triangles(); ++ti)
+        if (m.triangle_alive(ti)) {
+            Triangle t = m.triangle(ti);
+            for (int& v : t)
+                v = map[static_cast<size_t>(v)];
+            triangles.push_back(t);
+            labels.push_back(m.labels(ti));
+        }
+    const SurfaceMesh rebuilt(positions, triangles, labels);
+    EXPECT_EQ(m.compact(), map);
+    ASSERT_EQ(m.num_vertices(), rebuilt.num_vertices());
+    ASSERT_EQ(m.num_triangles(), rebuilt.num_triangles());
+    ASSERT_EQ(m.num_edges(), rebuilt.num_edges());
+    EXPECT_FALSE(m.has_dead_elements());
+    for (int vi = 0; vi < m.num_vertices(); ++vi) {
+        EXPECT_EQ(m.position(vi), rebuilt.position(vi));
+        EXPECT_EQ(m.vertex_triangles(vi), rebuilt.vertex_triangles(vi)) << "vertex " << vi;
+        EXPECT_EQ(m.vertex_edges(vi), rebuilt.vertex_edges(vi)) << "vertex " << vi;
+    }
+    for (int ti = 0; ti < m.num_triangles(); ++ti) {
+        EXPECT_EQ(m.triangle(ti), rebuilt.triangle(ti));
+        EXPECT_EQ(m.triangle_edges(ti), rebuilt.triangle_edges(ti));
+        EXPECT_EQ(m.labels(ti).inside, rebuilt.labels(ti).inside);
+        EXPECT_EQ(m.labels(ti).outside, rebuilt.labels(ti).outside);
+    }
+    for (int ei = 0; ei < m.num_edges(); ++ei) {
+        EXPECT_EQ(m.edge(ei), rebuilt.edge(ei));
+        EXPECT_EQ(m.edge_triangles(ei), rebuilt.edge_triangles(ei)) << "edge " << ei;
+    }
+    EXPECT_TRUE(validate_mesh(m, connectivity_only).empty());
+}
+
 TEST(SurfaceMesh, DuplicateVertexSeparatesFans) {
     // Two tetrahedra sharing only vertex 0: a singular vertex. Duplicating one fan separates them.
     SurfaceMesh m(

@@ -127,23 +127,28 @@ MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& optio
     MergeReport report;
     const double merge_distance = options.merge_distance_fraction * context.xi;
 
+    // Pairs of manifold edges closer than the merge distance: boxes padded by half of it
+    // overlap for every such pair, and the exact distance is tested inside the parallel join.
+    const auto proximity = [&mesh](int ei, int ej) {
+        const Edge& a = mesh.edge(ei);
+        const Edge& b = mesh.edge(ej);
+        return edge_edge_proximity(mesh.position(a[0]), mesh.position(a[1]),
+                                   mesh.position(b[0]), mesh.position(b[1]));
+    };
+    const std::vector<EdgeEdgePair> close = static_edge_edge_pairs(
+        mesh, 0.5 * merge_distance, [&](int ei, int ej) {
+            return mesh.edge_triangles(ei).size() == 2 && mesh.edge_triangles(ej).size() == 2 &&
+                   proximity(ei, ej).distance < merge_distance;
+        });
     std::vector<Candidate> candidates;
-    {
-        const BroadPhase broad_phase(mesh, 0.5 * merge_distance);
-        for (const EdgeEdgePair& pair : broad_phase.edge_edge_pairs()) {
-            if (mesh.edge_triangles(pair.ei).size() != 2 ||
-                mesh.edge_triangles(pair.ej).size() != 2)
-                continue;
-            const Edge& a = mesh.edge(pair.ei);
-            const Edge& b = mesh.edge(pair.ej);
-            const EdgeEdgeProximity p = edge_edge_proximity(
-                mesh.position(a[0]), mesh.position(a[1]), mesh.position(b[0]), mesh.position(b[1]));
-            if (p.distance < merge_distance) {
-                const Vec3 on_a = (1.0 - p.s) * mesh.position(a[0]) + p.s * mesh.position(a[1]);
-                const Vec3 on_b = (1.0 - p.u) * mesh.position(b[0]) + p.u * mesh.position(b[1]);
-                candidates.push_back({p.distance, a, b, 0.5 * (on_a + on_b)});
-            }
-        }
+    candidates.reserve(close.size());
+    for (const EdgeEdgePair& pair : close) {
+        const Edge& a = mesh.edge(pair.ei);
+        const Edge& b = mesh.edge(pair.ej);
+        const EdgeEdgeProximity p = proximity(pair.ei, pair.ej);
+        const Vec3 on_a = (1.0 - p.s) * mesh.position(a[0]) + p.s * mesh.position(a[1]);
+        const Vec3 on_b = (1.0 - p.u) * mesh.position(b[0]) + p.u * mesh.position(b[1]);
+        candidates.push_back({p.distance, a, b, 0.5 * (on_a + on_b)});
     }
     report.candidates = static_cast<int>(candidates.size());
     if (candidates.empty()) {

@@ -4,7 +4,10 @@
 #include "tracker/remesh/element_hash.h"
 #include "tracker/remesh/local_safety.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <cstdint>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -28,11 +31,32 @@ int find_root(std::vector<int>& parent, int i) {
     return i;
 }
 
+bool same_vertices(const Triangle& a, const Triangle& b) {
+    for (int v : a)
+        if (v != b[0] && v != b[1] && v != b[2])
+            return false;
+    return true;
+}
+
 /// Removes pairs of triangles on the same three vertices; returns how many pairs.
 int remove_degenerate_tetrahedra(SurfaceMesh& mesh) {
+    // Two triangles on the same vertices share every edge, so each finds the other among the
+    // triangles of its first edge: a pass over the triangles without sorting or allocation
+    // picks the few that are grouped below.
+    std::vector<std::uint8_t> duplicated(static_cast<size_t>(mesh.num_triangles()), 0);
+    tbb::parallel_for(0, mesh.num_triangles(), [&](int ti) {
+        if (!mesh.triangle_alive(ti))
+            return;
+        const Triangle& t = mesh.triangle(ti);
+        for (int other : mesh.edge_triangles(mesh.triangle_edges(ti)[0]))
+            if (other != ti && same_vertices(t, mesh.triangle(other))) {
+                duplicated[static_cast<size_t>(ti)] = 1;
+                return;
+            }
+    });
     std::map<std::array<int, 3>, std::vector<int>> by_vertices;
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
-        if (!mesh.triangle_alive(ti))
+        if (!duplicated[static_cast<size_t>(ti)])
             continue;
         std::array<int, 3> key = mesh.triangle(ti);
         std::sort(key.begin(), key.end());
@@ -127,6 +151,36 @@ std::vector<std::vector<int>> singular_vertex_fans(const SurfaceMesh& mesh, int 
     return fans;
 }
 
+/// True when vi's triangles form one fan joined through manifold edges (each of its edges has
+/// two triangles): the common case, which vertex_fans() would report as a single fan, decided
+/// by walking once around vi instead of by union-find.
+bool one_manifold_fan(const SurfaceMesh& mesh, int vi) {
+    const std::vector<int>& tris = mesh.vertex_triangles(vi);
+    if (tris.empty())
+        return false;
+    for (int ei : mesh.vertex_edges(vi))
+        if (mesh.edge_triangles(ei).size() != 2)
+            return false;
+    int current = tris[0];
+    int came_through = INVALID_INDEX;
+    size_t visited = 0;
+    do {
+        ++visited;
+        int next_edge = INVALID_INDEX;
+        for (int ei : mesh.triangle_edges(current)) {
+            const Edge& e = mesh.edge(ei);
+            if ((e[0] == vi || e[1] == vi) && ei != came_through) {
+                next_edge = ei;
+                break;
+            }
+        }
+        const std::vector<int>& et = mesh.edge_triangles(next_edge);
+        current = et[0] == current ? et[1] : et[0];
+        came_through = next_edge;
+    } while (current != tris[0] && visited <= tris.size());
+    return current == tris[0] && visited == tris.size();
+}
+
 Vec3 fan_centroid(const SurfaceMesh& mesh, const std::vector<int>& fan, int vi) {
     Vec3 sum = Vec3::Zero();
     int count = 0;
@@ -191,7 +245,17 @@ SeparationReport separate(SurfaceMesh& mesh, const SeparationOptions& options,
 
     std::unique_ptr<ElementHash> hash;
     const int vertex_count = mesh.num_vertices();
+    // Splitting a singular vertex rewires only its own triangles, whose edges to a vertex with
+    // one manifold fan stay manifold: such a vertex stays regular, and only the others (found in
+    // parallel) need the full fan analysis, in index order as before.
+    std::vector<std::uint8_t> regular(static_cast<size_t>(vertex_count), 0);
+    tbb::parallel_for(0, vertex_count, [&](int vi) {
+        regular[static_cast<size_t>(vi)] =
+            !mesh.vertex_alive(vi) || one_manifold_fan(mesh, vi) ? 1 : 0;
+    });
     for (int vi = 0; vi < vertex_count; ++vi) {
+        if (regular[static_cast<size_t>(vi)])
+            continue;
         const std::vector<std::vector<int>> fans = singular_vertex_fans(mesh, vi);
         if (fans.empty())
             continue;
