@@ -159,6 +159,9 @@ void visit_fields(V& v, CouplingOptions& o) {
               Range::between(0, 20), "", "one-ring averaging passes over vertex curvature");
     v.number("subgrid_rate", o.simulation.surface_tension.subgrid_rate, Range::between(0.0, 0.2),
              "", "damping rate β of mesh-scale wrinkles the grid cannot resolve (0 = off)");
+    v.integer("subgrid_filter_order", o.simulation.surface_tension.subgrid_filter_order,
+              Range::between(1, 3), "",
+              "order m of the sub-grid high-pass (I − S)^m; a resolved wave feels ε^m of the damping");
     enum_field(v, "velocity_interpolation", o.simulation.interpolate.method,
                {{"trilinear", coupling::VelocityInterpolation::trilinear},
                 {"quadratic_bspline", coupling::VelocityInterpolation::quadratic_bspline},

@@ -162,7 +162,8 @@ void Simulation::add_subgrid_tension(std::vector<tracker::Vec3>& velocities, dou
             (x.array() >= lo.array()).all() && (x.array() <= hi.array()).all() ? 1 : 0;
     }
     const std::vector<tracker::Vec3> subgrid =
-        subgrid_tension_velocities(mesh, diffusivity, options.subgrid_resolved_passes, inside);
+        subgrid_tension_velocities(mesh, diffusivity, options.subgrid_resolved_passes,
+                                   options.subgrid_filter_order, inside);
     const double max_speed = MAX_SUBGRID_STEP_EDGES * h / dt;
     for (size_t v = 0; v < velocities.size(); ++v) {
         const double speed = subgrid[v].norm();

@@ -27,6 +27,9 @@ using tracker::Vec3;
 /// cotangent Laplacian's stability limit (about h²/3 on an equilateral mesh) with room for
 /// irregular triangles.
 constexpr double MAX_SUBGRID_RATE = 0.2;
+/// Upper bound of SurfaceTensionOptions::subgrid_filter_order (beyond 3 the filter is as sharp
+/// as its smoothing stencil allows and only costs passes).
+constexpr int MAX_SUBGRID_FILTER_ORDER = 3;
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
@@ -123,15 +126,23 @@ void SurfaceTensionOptions::validate() const {
     if (subgrid_resolved_passes < 1)
         throw std::invalid_argument("subgrid_resolved_passes: expected an integer >= 1, got " +
                                     std::to_string(subgrid_resolved_passes));
+    if (subgrid_filter_order < 1 || subgrid_filter_order > MAX_SUBGRID_FILTER_ORDER)
+        throw std::invalid_argument("subgrid_filter_order: expected an integer in [1, " +
+                                    std::to_string(MAX_SUBGRID_FILTER_ORDER) + "], got " +
+                                    std::to_string(subgrid_filter_order));
 }
 
 std::vector<tracker::Vec3> subgrid_tension_velocities(const tracker::SurfaceMesh& mesh,
                                                       double diffusivity, int resolved_passes,
+                                                      int filter_order,
                                                       const std::vector<char>& active) {
     if (!(diffusivity >= 0.0))
         throw std::invalid_argument("subgrid_tension_velocities: diffusivity must be >= 0");
     if (resolved_passes < 1)
         throw std::invalid_argument("subgrid_tension_velocities: resolved_passes must be >= 1");
+    if (filter_order < 1 || filter_order > MAX_SUBGRID_FILTER_ORDER)
+        throw std::invalid_argument("subgrid_tension_velocities: filter_order must be in [1, " +
+                                    std::to_string(MAX_SUBGRID_FILTER_ORDER) + "]");
     if (!active.empty() && active.size() != static_cast<size_t>(mesh.num_vertices()))
         throw std::invalid_argument(
             "subgrid_tension_velocities: active must be empty or sized num_vertices()");
@@ -143,10 +154,15 @@ std::vector<tracker::Vec3> subgrid_tension_velocities(const tracker::SurfaceMesh
     for (int axis = 0; axis < 3; ++axis) {
         for (size_t v = 0; v < component.size(); ++v)
             component[v] = curvature_normal[v][axis];
-        const std::vector<double> resolved = smooth_vertex_values(mesh, component, resolved_passes);
+        // (I − S)^order K: each application removes what S keeps.
+        for (int order = 0; order < filter_order; ++order) {
+            const std::vector<double> resolved =
+                smooth_vertex_values(mesh, component, resolved_passes);
+            for (size_t v = 0; v < component.size(); ++v)
+                component[v] -= resolved[v];
+        }
         for (size_t v = 0; v < component.size(); ++v)
-            velocities[v][axis] =
-                active.empty() || active[v] ? -diffusivity * (component[v] - resolved[v]) : 0.0;
+            velocities[v][axis] = active.empty() || active[v] ? -diffusivity * component[v] : 0.0;
     }
     remove_volume_change(mesh, velocities, active);
     return velocities;

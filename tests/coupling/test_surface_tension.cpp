@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <vector>
 
 namespace meniscus::coupling {
@@ -238,11 +239,12 @@ TEST(SurfaceTension, SubgridTensionFlattensMeshScaleWrinklesAndSparesTheSphere) 
     const Vector3d centre = Vector3d::Constant(0.5);
     const tracker::SurfaceMesh sphere = sphere_mesh(centre, radius, edge);
     const int passes = SurfaceTensionOptions{}.subgrid_resolved_passes;
+    const int order = SurfaceTensionOptions{}.subgrid_filter_order;
     const double diffusivity = 1.0;
     const double dt = 0.05 * edge * edge / diffusivity;  // rate β = D Δt / h² = 0.05 per step
     // On the smooth sphere the sub-grid speed is a small fraction of the full flow speed κ·D.
     double sphere_speed = 0.0;
-    for (const tracker::Vec3& v : subgrid_tension_velocities(sphere, diffusivity, passes))
+    for (const tracker::Vec3& v : subgrid_tension_velocities(sphere, diffusivity, passes, order))
         sphere_speed = std::max(sphere_speed, v.norm());
     std::printf("sub-grid speed on a sphere: %.4f of the mean-curvature flow speed\n",
                 sphere_speed / (diffusivity * 2.0 / radius));
@@ -274,7 +276,7 @@ TEST(SurfaceTension, SubgridTensionFlattensMeshScaleWrinklesAndSparesTheSphere) 
     const int steps = 20;
     for (int step = 0; step < steps; ++step) {
         const std::vector<tracker::Vec3> velocity =
-            subgrid_tension_velocities(wrinkled, diffusivity, passes);
+            subgrid_tension_velocities(wrinkled, diffusivity, passes, order);
         for (int vi = 0; vi < wrinkled.num_vertices(); ++vi)
             wrinkled.set_position(vi,
                                   wrinkled.position(vi) + dt * velocity[static_cast<size_t>(vi)]);
@@ -286,8 +288,69 @@ TEST(SurfaceTension, SubgridTensionFlattensMeshScaleWrinklesAndSparesTheSphere) 
         error0 / edge, error1 / edge, steps, tracker::enclosed_volume(wrinkled) / volume0 - 1.0);
     EXPECT_LT(error1, 0.2 * error0);
     EXPECT_NEAR(tracker::enclosed_volume(wrinkled), volume0, 1e-4 * volume0);
-    EXPECT_THROW(subgrid_tension_velocities(sphere, -1.0, passes), std::invalid_argument);
-    EXPECT_THROW(subgrid_tension_velocities(sphere, 1.0, 0), std::invalid_argument);
+    EXPECT_THROW(subgrid_tension_velocities(sphere, -1.0, passes, order), std::invalid_argument);
+    EXPECT_THROW(subgrid_tension_velocities(sphere, 1.0, 0, order), std::invalid_argument);
+}
+
+TEST(SurfaceTension, SquaredSubgridFilterSparesResolvedWavesAndDampsWrinklesAlike) {
+    // Regression for B4 (the capillary wave 5 % slow at 32 cells per wavelength): a resolved
+    // pattern that the smoothing S keeps to 1 − ε leaks through the first-order high-pass
+    // I − S as about ε and damps the resolved wave; through (I − S)² only ε². On a sphere with
+    // ~20 edges per radius, a degree-3 spherical harmonic (a smooth, resolved wrinkle) and the
+    // roughest pattern the mesh carries (mesh scale), each 5 % of an edge radially.
+    const double radius = 0.3;
+    const double edge = 1.0 / 64;
+    const Vector3d centre = Vector3d::Constant(0.5);
+    const tracker::SurfaceMesh sphere = sphere_mesh(centre, radius, edge);
+    const int passes = SurfaceTensionOptions{}.subgrid_resolved_passes;
+    const std::vector<double> roughest = roughest_pattern(sphere);
+    const auto perturbed = [&](const std::function<double(int, const Vector3d&)>& pattern) {
+        tracker::SurfaceMesh mesh = sphere;
+        for (int vi = 0; vi < sphere.num_vertices(); ++vi) {
+            const Vector3d n = (sphere.position(vi) - centre).normalized();
+            mesh.set_position(vi, sphere.position(vi) + 0.05 * edge * pattern(vi, n) * n);
+        }
+        return mesh;
+    };
+    // The response of the radial sub-grid speed to the pattern (the unperturbed sphere's own
+    // speed, its mesh-scale curvature noise, subtracted), projected on the pattern per unit
+    // amplitude: the rate at which the filter damps it, per unit diffusivity.
+    const auto damping = [&](const tracker::SurfaceMesh& mesh,
+                             const std::function<double(int, const Vector3d&)>& pattern,
+                             int order) {
+        const std::vector<tracker::Vec3> v = subgrid_tension_velocities(mesh, 1.0, passes, order);
+        const std::vector<tracker::Vec3> v0 =
+            subgrid_tension_velocities(sphere, 1.0, passes, order);
+        double along = 0.0, norm = 0.0;
+        for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+            const Vector3d n = (sphere.position(vi) - centre).normalized();
+            const double p = pattern(vi, n);
+            along += (v[static_cast<size_t>(vi)] - v0[static_cast<size_t>(vi)]).dot(n) * p;
+            norm += p * p;
+        }
+        return -along / norm / (0.05 * edge);
+    };
+    const auto harmonic = [](int, const Vector3d& n) {
+        return n.z() * (5.0 * n.z() * n.z() - 3.0);  // P₃(cos θ) up to a factor
+    };
+    const auto rough = [&](int vi, const Vector3d&) {
+        return roughest[static_cast<size_t>(vi)];
+    };
+    const tracker::SurfaceMesh smooth_wrinkle = perturbed(harmonic);
+    const tracker::SurfaceMesh mesh_wrinkle = perturbed(rough);
+    const double smooth1 = damping(smooth_wrinkle, harmonic, 1);
+    const double smooth2 = damping(smooth_wrinkle, harmonic, 2);
+    const double rough1 = damping(mesh_wrinkle, rough, 1);
+    const double rough2 = damping(mesh_wrinkle, rough, 2);
+    std::printf("damping rate per unit D: P3 wrinkle %.4g (order 1) %.4g (order 2); mesh-scale "
+                "%.4g, %.4g\n",
+                smooth1, smooth2, rough1, rough2);
+    // The mesh-scale pattern is damped at nearly the same rate; the resolved one far less.
+    EXPECT_GT(rough2, 0.8 * rough1);
+    EXPECT_GT(rough2, 0.0);
+    EXPECT_LT(std::abs(smooth2), 0.1 * std::abs(smooth1));
+    EXPECT_THROW(subgrid_tension_velocities(sphere, 1.0, passes, 0), std::invalid_argument);
+    EXPECT_THROW(subgrid_tension_velocities(sphere, 1.0, passes, 4), std::invalid_argument);
 }
 
 TEST(SurfaceTension, SubgridTensionMovesOnlyActiveVerticesAndKeepsTheirVolume) {
@@ -304,9 +367,11 @@ TEST(SurfaceTension, SubgridTensionMovesOnlyActiveVerticesAndKeepsTheirVolume) {
     for (int vi = 0; vi < box.num_vertices(); ++vi)
         active[static_cast<size_t>(vi)] = box.position(vi).x() < 0.5 ? 1 : 0;
     const std::vector<tracker::Vec3> velocity =
-        subgrid_tension_velocities(box, 1.0, SurfaceTensionOptions{}.subgrid_resolved_passes, active);
+        subgrid_tension_velocities(box, 1.0, SurfaceTensionOptions{}.subgrid_resolved_passes,
+                                   SurfaceTensionOptions{}.subgrid_filter_order, active);
     const std::vector<tracker::Vec3> all =
-        subgrid_tension_velocities(box, 1.0, SurfaceTensionOptions{}.subgrid_resolved_passes);
+        subgrid_tension_velocities(box, 1.0, SurfaceTensionOptions{}.subgrid_resolved_passes,
+                                   SurfaceTensionOptions{}.subgrid_filter_order);
     double moved = 0.0;
     for (int vi = 0; vi < box.num_vertices(); ++vi) {
         if (active[static_cast<size_t>(vi)])
@@ -333,7 +398,7 @@ TEST(SurfaceTension, SubgridTensionMovesOnlyActiveVerticesAndKeepsTheirVolume) {
     };
     EXPECT_LT(volume_rate(velocity), 1e-12);
     EXPECT_LT(volume_rate(all), 1e-12);
-    EXPECT_THROW(subgrid_tension_velocities(box, 1.0, 4, std::vector<char>(3, 1)),
+    EXPECT_THROW(subgrid_tension_velocities(box, 1.0, 4, 1, std::vector<char>(3, 1)),
                  std::invalid_argument);
 }
 
@@ -442,6 +507,11 @@ TEST(SurfaceTension, InvalidOptionsAndMismatchedRasterAreRejected) {
     options = SurfaceTensionOptions{};
     options.subgrid_resolved_passes = 0;
     EXPECT_THROW(options.validate(), std::invalid_argument);
+    for (int order : {0, 4}) {
+        options = SurfaceTensionOptions{};
+        options.subgrid_filter_order = order;
+        EXPECT_THROW(options.validate(), std::invalid_argument) << "order " << order;
+    }
     const fluid::MacGrid grid(8, 8, 8, 0.125);
     const fluid::MacGrid other(9, 8, 8, 0.125);
     const tracker::SurfaceMesh mesh = sphere_mesh(Vector3d::Constant(0.5), 0.3, 0.1);
