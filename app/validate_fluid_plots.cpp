@@ -187,7 +187,9 @@ if "B7" in b:
     for r in B7["runs"]:
         s = r["series"]
         ax.plot([1e3 * x for x in s["speed_t"]], [1e3 * u for u in s["speed"]], "-", lw=1,
-                label="%d cells per D, dt factor %g" % (r["cells_per_diameter"], r["dt_factor"]))
+                label="%d cells per D, %s, dt factor %g" % (r["cells_per_diameter"],
+                                                            r.get("weights", "sharp"),
+                                                            r["dt_factor"]))
         ax.axhline(1e3 * r["reference_speed"], color="k", ls=":", lw=1)
     ax.plot([], [], "k:", label="Hadamard-Rybczynski, wall-corrected")
     ax.set_xlabel("t (ms)")
@@ -196,7 +198,14 @@ if "B7" in b:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7)
     study_panel(bx, B7["speed"], "cells per diameter", 0.05)
-    bx.set_title("B7 rise speed error")
+    blended = B7.get("speed_volume_fraction")
+    if blended and blended["rows"]:
+        bx.loglog([row["resolution"] for row in blended["rows"]],
+                  [max(abs(row["runs"][0]["relative_error"]) * 100, 1e-3)
+                   for row in blended["rows"]], "s--", ms=4,
+                  label="rise speed U, volume_fraction weights, own dt")
+        bx.legend(fontsize=7)
+    bx.set_title("B7 rise speed error (sharp weights unless marked)")
     save(fig, "b7_creeping_bubble.png")
 )PY";
 

@@ -10,6 +10,9 @@
 #include "app/run.h"
 
 #include <cmath>
+#include <map>
+#include <string>
+#include <utility>
 
 namespace meniscus::app::validate_fluid {
 
@@ -160,7 +163,11 @@ void creeping_bubble_case(CaseContext& context, std::ostringstream& md) {
     const double a = B7_RADIUS, box = box_radii * a;
     const double nu = B7_MU_LIQUID / B7_RHO_LIQUID;
     const double end = B7_END_VISCOUS_TIMES * box * box / nu;
-    Study speed{"rise speed U", "m/s", {}};
+    // The default weights (sharp) at every Δt; the volume-fraction weights at the solver's own.
+    const std::vector<std::string> weightings = {"sharp", "volume_fraction"};
+    std::map<std::string, Study> speed;
+    for (const std::string& w : weightings)
+        speed.emplace(w, Study{"rise speed U", "m/s", {}});
     Json runs = Json::array();
     CreepingRiseSetup setup;
     setup.radius = a;
@@ -184,7 +191,15 @@ void creeping_bubble_case(CaseContext& context, std::ostringstream& md) {
                          {{"type", "sphere"},
                           {"center", {box / 2, box / 2, box / 2}},
                           {"radius", a}}}};
-        for (double factor : factors) {
+        std::vector<std::pair<std::string, double>> variants;  // (weights, Δt factor)
+        for (double factor : factors)
+            variants.emplace_back(weightings.front(), factor);
+        for (size_t w = 1; w < weightings.size(); ++w)
+            variants.emplace_back(weightings[w], 1.0);
+        for (const auto& variant : variants) {
+            const std::string& weights = variant.first;
+            const double factor = variant.second;
+            j["fluid"]["viscosity_weights"] = weights;
             std::vector<double> t, u, z;
             const auto sample = [&](const coupling::Simulation& s) {
                 if (s.time() == 0.0)
@@ -194,8 +209,9 @@ void creeping_bubble_case(CaseContext& context, std::ostringstream& md) {
                 z.push_back(volume_moments(s.tracker().mesh()).centroid.z());
             };
             const FluidRunRecord r = run_case(j, factor, end, sample);
-            const std::string what =
-                "B7 " + std::to_string(2 * cpr) + " cells per diameter, Δt factor " + fmt(factor);
+            const std::string what = "B7 " + std::to_string(2 * cpr) +
+                                     " cells per diameter, " + weights + " weights, Δt factor " +
+                                     fmt(factor);
             context.check(what, r);
             // Time averages over the last quarter, and over the quarter before (steadiness).
             double late = 0.0, earlier = 0.0, late_z = 0.0;
@@ -214,10 +230,11 @@ void creeping_bubble_case(CaseContext& context, std::ostringstream& md) {
             earlier /= std::max(n_earlier, 1);
             setup.centre = Vector3d(box / 2, box / 2, late_z / std::max(n_late, 1));
             const CreepingRise reference = creeping_rise(setup);
-            speed.add(2 * cpr, dx, {factor, r.first_dt, late, reference.speed, r.steps,
-                                    r.wall_seconds});
+            speed.at(weights).add(2 * cpr, dx, {factor, r.first_dt, late, reference.speed,
+                                                r.steps, r.wall_seconds});
             Json run = run_summary(r);
             run.update({{"cells_per_diameter", 2 * cpr},
+                        {"weights", weights},
                         {"dt_factor", factor},
                         {"dt", r.first_dt},
                         {"diffusion_number", nu * r.first_dt / (dx * dx)},
@@ -244,7 +261,8 @@ void creeping_bubble_case(CaseContext& context, std::ostringstream& md) {
                                  {"wall_coefficient", centre.wall_coefficient},
                                  {"t_end", end},
                                  {"box_radii", box_radii},
-                                 {"speed", study_json(speed)}};
+                                 {"speed", study_json(speed.at("sharp"))},
+                                 {"speed_volume_fraction", study_json(speed.at("volume_fraction"))}};
     const double reynolds = 2.0 * a * centre.speed * B7_RHO_LIQUID / B7_MU_LIQUID;
     md << "## B7 — creeping bubble rise\n\n"
        << "A gas bubble a = 1 mm (ρ 1 kg/m³, μ 2e-3 Pa·s) rising under gravity through a very "
@@ -270,7 +288,17 @@ void creeping_bubble_case(CaseContext& context, std::ostringstream& md) {
        << percent(centre.speed, centre.unbounded)
        << "), evaluated at the run's mean height. Neglected: the walls' reflection of the "
           "bubble's dipole (O(κ(a/ℓ)³)) and stresslet (O((a/ℓ)⁴)), and inertia (O(Re)).\n\n"
-       << study_markdown(speed, "cells per D", B7_TARGET, 16) << "\n"
+       << "With the default `/fluid/viscosity_weights` `sharp` (each cell's μ by its phase, the "
+          "edges' harmonic mean):\n\n"
+       << study_markdown(speed.at("sharp"), "cells per D", B7_TARGET, 16) << "\n"
+       << "With `volume_fraction` (μ blended by the liquid fraction of each control volume, "
+          "Batty & Bridson 2008), at the solver's own Δt:\n\n"
+       << study_markdown(speed.at("volume_fraction"), "cells per D", B7_TARGET, 16) << "\n"
+       << "The sharp weights let the gas's low viscosity reach half a cell into the liquid, so "
+          "the bubble rises too fast; the blended ones give the liquid's viscosity to part of "
+          "the gas, so it rises too slowly, by about half as much and converging faster. They "
+          "are not the default: on drop_merge (water in air) they cost 1.7× the wall time "
+          "and let the merged drops part again for a frame.\n\n"
        << "Plot: b7_creeping_bubble.png.\n\n";
 }
 
