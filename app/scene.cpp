@@ -116,6 +116,11 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
                 {"volume_fraction", fluid::ViscosityWeights::volume_fraction}},
                "two_phase μ next to the interface: `sharp` (cell phase, harmonic mean on edges) "
                "or `volume_fraction` (blended by the liquid fraction of each control volume)");
+    enum_field(v, "viscosity_preconditioner", o.viscosity.preconditioner,
+               {{"multigrid", fluid::ViscousPreconditioner::multigrid},
+                {"jacobi", fluid::ViscousPreconditioner::jacobi}},
+               "preconditioner of the viscous CG: a V-cycle per velocity component's block, or "
+               "the diagonal");
     v.integer("viscosity_max_iterations", o.viscosity.iteration.max_iterations,
               Range::between(1, 100000), "", "CG iterations before a viscosity solve gives up");
     v.section("viscous_pressure", "how the viscous and pressure solves are coupled in a step",

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "fluid/multigrid.h"
 #include "fluid/poisson_matrix.h"
 
 namespace meniscus::fluid {
@@ -130,6 +131,37 @@ public:
                             weight(above[0], above[1], above[2]) * c_above * c_above);
                 }
                 d[flat] = sum;
+            });
+        }
+    }
+
+    /// The diagonal blocks of ρ + K, each velocity component coupled with itself alone (the
+    /// normal-stress couplings through cells, the shear couplings through edges), as 7-point
+    /// matrices on that component's face lattice: same diagonal `d` (diagonal()) as the whole
+    /// operator, fixed faces inactive (zero rows and columns).
+    void component_blocks(const std::vector<double>& d,
+                          std::array<PoissonMatrix, 3>& blocks) const {
+        const double scale = 2.0 * m_dt / (m_dx * m_dx);
+        for (int a = 0; a < 3; ++a) {
+            const Index3& dims = m_face_dims[a];
+            PoissonMatrix& m = blocks[static_cast<std::size_t>(a)];
+            m.resize(dims[0], dims[1], dims[2]);
+            Array3<double>* off[3] = {&m.off_x, &m.off_y, &m.off_z};
+            for_each_face(a, [&](const Index3& f, std::size_t flat) {
+                if (!m_unknown[flat])
+                    return;
+                m.diag(f[0], f[1], f[2]) = d[flat];
+                for (int b = 0; b < 3; ++b) {
+                    Index3 next = f;
+                    ++next[b];
+                    if (next[b] >= dims[b] || !m_unknown[face_flat(a, next)])
+                        continue;
+                    // Along a the two faces share cell f; across b the edge between them.
+                    const double weight =
+                        b == a ? m_mu(f[0], f[1], f[2])
+                               : m_edge_weight[3 - a - b](next[0], next[1], next[2]);
+                    (*off[b])(f[0], f[1], f[2]) = -scale * weight;
+                }
             });
         }
     }
@@ -423,6 +455,10 @@ void ViscosityOptions::validate() const {
     iteration.validate();
     if (weights != ViscosityWeights::sharp && weights != ViscosityWeights::volume_fraction)
         throw std::invalid_argument("ViscosityOptions.weights: unknown weighting");
+    if (preconditioner != ViscousPreconditioner::jacobi &&
+        preconditioner != ViscousPreconditioner::multigrid)
+        throw std::invalid_argument("ViscosityOptions.preconditioner: unknown preconditioner");
+    multigrid.validate();
 }
 
 /// What the operator was last built from: the coupled scheme's Uzawa passes solve again with
@@ -467,6 +503,10 @@ struct ViscositySolver::Workspace {
     ViscousOperator op;
     OperatorKey key;  ///< what `op` and `diagonal` were built from (empty φ: nothing yet)
     std::vector<double> u_star, fixed, x, b, r, z, p, q, diagonal;
+    /// multigrid: the component blocks and their V-cycles (built on first use after `op`).
+    std::array<PoissonMatrix, 3> blocks;
+    std::array<std::unique_ptr<MultigridPreconditioner>, 3> cycles;
+    std::array<std::vector<double>, 3> block_r, block_z;
 };
 
 ViscositySolver::ViscositySolver() : m_workspace(std::make_unique<Workspace>()) {}
@@ -499,6 +539,8 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     if (!reuse) {
         ws.key.phi.clear();  // nothing valid until the build is complete
         ws.diagonal.clear();
+        for (auto& cycle : ws.cycles)
+            cycle.reset();
         op.build(grid, interface.phi, phases, mode, walls, dt, min_liquid_fraction,
                  options.weights);
         key.phi = interface.phi.storage();
@@ -534,13 +576,38 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         if (ws.diagonal.empty())
             op.diagonal(ws.diagonal);
         const std::vector<double>& diagonal = ws.diagonal;
+        const bool multigrid = options.preconditioner == ViscousPreconditioner::multigrid;
+        if (multigrid && !ws.cycles[0]) {
+            op.component_blocks(diagonal, ws.blocks);
+            for (std::size_t a = 0; a < 3; ++a)
+                ws.cycles[a] =
+                    std::make_unique<MultigridPreconditioner>(ws.blocks[a], options.multigrid);
+        }
+        // z = M⁻¹ r: Jacobi, or a V-cycle on each component's block (r is zero on fixed faces,
+        // and so is z).
+        const auto precondition = [&]() {
+            if (!multigrid) {
+                for (std::size_t f = 0; f < n; ++f)
+                    z[f] = r[f] / diagonal[f];
+                return;
+            }
+            std::size_t offset = 0;
+            for (std::size_t a = 0; a < 3; ++a) {
+                const std::size_t size = ws.blocks[a].size();
+                ws.block_r[a].assign(r.begin() + static_cast<std::ptrdiff_t>(offset),
+                                     r.begin() + static_cast<std::ptrdiff_t>(offset + size));
+                ws.cycles[a]->apply(ws.block_r[a], ws.block_z[a]);
+                std::copy(ws.block_z[a].begin(), ws.block_z[a].end(),
+                          z.begin() + static_cast<std::ptrdiff_t>(offset));
+                offset += size;
+            }
+        };
         r.resize(n);
         z.resize(n);
         op.apply(x, q);
-        for (std::size_t f = 0; f < n; ++f) {
+        for (std::size_t f = 0; f < n; ++f)
             r[f] = b[f] - q[f];
-            z[f] = r[f] / diagonal[f];
-        }
+        precondition();
         p = z;
         double rz = dot(r, z);
         result.residual = std::sqrt(dot(r, r)) / b_norm;
@@ -558,9 +625,7 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
             ++result.iterations;
             result.residual = std::sqrt(dot(r, r)) / b_norm;
             result.converged = result.residual <= options.iteration.tolerance;
-            for (std::size_t f = 0; f < n; ++f) {
-                z[f] = r[f] / diagonal[f];
-            }
+            precondition();
             const double rz_new = dot(r, z);
             xpby(z, rz_new / rz, p);
             rz = rz_new;
