@@ -106,9 +106,9 @@ std::vector<Vec3> volume_restoring_displacements(const SurfaceMesh& mesh,
             continue;
         const Triangle& t = mesh.triangle(ti);
         const Vec3& a = positions[static_cast<size_t>(t[0])];
-        const Vec3 third_area =
-            ((positions[static_cast<size_t>(t[1])] - a).cross(positions[static_cast<size_t>(t[2])] - a)) /
-            6.0;
+        const Vec3& b = positions[static_cast<size_t>(t[1])];
+        const Vec3& c = positions[static_cast<size_t>(t[2])];
+        const Vec3 third_area = (b - a).cross(c - a) / 6.0;  // ⅓ of the area vector
         for (int vi : t)
             gradient[static_cast<size_t>(vi)] += third_area;
     }
