@@ -387,6 +387,13 @@ void visit_fields(V& v, tracker::CollisionOptions& o) {
               Range::between(1, 2'000'000'000), "",
               "largest impact-zone matrix assembled (entries, 16 bytes each); larger zones move "
               "rigidly");
+    v.boolean("preserve_volume", o.preserve_volume,
+              "volume-aware response (not in the paper): each closed component gets back the "
+              "volume collision handling changed, through the vertices it left alone; kept only "
+              "when CCD verifies the corrected motion");
+    v.integer("max_volume_rounds", o.max_volume_rounds, Range::between(1, 100), "",
+              "attempts of that correction; each one CCD rejects leaves the vertices of its "
+              "collisions out of the next");
 }
 
 template <typename V>

@@ -4,6 +4,7 @@
 #include "tracker/ccd.h"
 #include "tracker/distance.h"
 #include "tracker/impact_zone.h"
+#include "tracker/volume_constraint.h"
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -49,6 +50,13 @@ constexpr double CANDIDATE_SLACK_GROWTH = 4.0;
 /// boxes padded by more would pair far too many elements.
 constexpr double CANDIDATE_SLACK_CAP = 0.25;
 constexpr double CANDIDATE_SLACK_EDGE_CAP = 0.05;
+
+/// A closed component's volume error below this fraction of its volume is round-off of the
+/// volume sums, not something collision handling changed: the volume correction leaves it.
+constexpr double VOLUME_ERROR_TOLERANCE = 1e-13;
+/// Newton steps of one volume correction attempt at most (each a linearised solve and a volume
+/// sum; the CCD check follows the last).
+constexpr int VOLUME_NEWTON_ITERATIONS = 3;
 
 /// Items per task of ordered_parallel_collect.
 constexpr size_t COLLECT_CHUNK = 4096;
@@ -293,8 +301,92 @@ public:
         return detect(d).empty();
     }
 
+    /// CollisionOptions::preserve_volume on the collision-free motion x0 → x0 + d whose
+    /// requested displacements were `reference`: each closed component gets back the volume
+    /// the response changed, through the vertices the response left at their requested
+    /// displacement; a corrected motion is kept only when detect() finds it free, and each
+    /// rejected attempt takes the vertices of the collisions it found out of the next one.
+    void restore_volume(const std::vector<Vec3>& reference, std::vector<Vec3>& d,
+                        CollisionReport& report) {
+        const size_t n = m_x0.size();
+        std::vector<std::uint8_t> movable(n, 0);
+        bool responded = false;
+        for (size_t i = 0; i < n; ++i) {
+            movable[i] = d[i] == reference[i] ? 1 : 0;
+            responded = responded || !movable[i];
+        }
+        if (!responded)
+            return;  // the response changed nothing
+        const VolumeComponents components = volume_components(m_mesh);
+        const std::vector<double> requested =
+            component_volumes_at(m_mesh, components, ends(reference));
+        const std::vector<double> responded_volume =
+            component_volumes_at(m_mesh, components, ends(d));
+        std::vector<double> error(static_cast<size_t>(components.count), 0.0);
+        double volume_scale = 0.0;  // Σ |V| of the components corrected
+        bool any = false;
+        for (size_t c = 0; c < error.size(); ++c) {
+            const double e = requested[c] - responded_volume[c];
+            if (!components.closed[c] ||
+                !(std::abs(e) > VOLUME_ERROR_TOLERANCE * std::abs(requested[c])))
+                continue;
+            error[c] = e;
+            volume_scale += std::abs(requested[c]);
+            report.volume_error_before += std::abs(e);
+            any = true;
+        }
+        report.volume_error_after = report.volume_error_before;
+        if (!any)
+            return;
+        for (int round = 0; round < m_o.max_volume_rounds; ++round) {
+            // Newton on the volume constraints (each step the linearised solve at the current
+            // positions): the volume is cubic in the positions, and one linear step leaves an
+            // error of second order in the correction.
+            std::vector<Vec3> trial = d;
+            for (int it = 0; it < VOLUME_NEWTON_ITERATIONS; ++it) {
+                const std::vector<Vec3> x = ends(trial);
+                std::vector<double> residual = component_volumes_at(m_mesh, components, x);
+                double remaining = 0.0;
+                for (size_t c = 0; c < error.size(); ++c) {
+                    residual[c] = error[c] != 0.0 ? requested[c] - residual[c] : 0.0;
+                    remaining += std::abs(residual[c]);
+                }
+                if (!(remaining > VOLUME_ERROR_TOLERANCE * volume_scale))
+                    break;
+                const std::vector<Vec3> delta = volume_restoring_displacements(
+                    m_mesh, components, x, residual, movable, m_inv_mass);
+                for (size_t i = 0; i < n; ++i)
+                    trial[i] += delta[i];
+            }
+            ++report.volume_rounds;
+            const std::vector<Contact> hits = detect(trial);
+            if (hits.empty()) {
+                d = std::move(trial);
+                report.volume_restored = true;
+                const std::vector<double> corrected =
+                    component_volumes_at(m_mesh, components, ends(d));
+                report.volume_error_after = 0.0;
+                for (size_t c = 0; c < error.size(); ++c)
+                    if (error[c] != 0.0)
+                        report.volume_error_after += std::abs(requested[c] - corrected[c]);
+                return;
+            }
+            for (const Contact& c : hits)
+                for (int k = 0; k < 4; ++k)
+                    movable[static_cast<size_t>(c.vertices[k])] = 0;
+        }
+    }
+
 private:
     const Vec3& x0(int vi) const { return m_x0[static_cast<size_t>(vi)]; }
+
+    /// x0 + d.
+    std::vector<Vec3> ends(const std::vector<Vec3>& d) const {
+        std::vector<Vec3> x(m_x0.size());
+        for (size_t i = 0; i < x.size(); ++i)
+            x[i] = m_x0[i] + d[i];
+        return x;
+    }
 
     /// Mean length of the live edges at t0 (computed once).
     double mean_edge_length() {
@@ -537,6 +629,8 @@ void CollisionOptions::validate() const {
         throw std::invalid_argument("max_step_shortenings: expected an integer >= 0");
     if (max_zone_matrix_entries < 1)
         throw std::invalid_argument("max_zone_matrix_entries: expected an integer >= 1");
+    if (max_volume_rounds < 1)
+        throw std::invalid_argument("max_volume_rounds: expected an integer >= 1");
 }
 
 CollisionReport resolve_collisions(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
@@ -565,17 +659,23 @@ CollisionReport resolve_collisions(const SurfaceMesh& mesh, const std::vector<Ve
     if (options.repulsion)
         report.proximities = resolver.repel(d);
 
+    // The verified motion x_t0 → x_t0 + free, requested as x_t0 + reference (the requested
+    // displacements, shortened with the step), made volume-aware when asked.
+    const auto finish = [&](std::vector<Vec3>& free, const std::vector<Vec3>& reference) {
+        if (options.preserve_volume)
+            resolver.restore_volume(reference, free, report);
+        for (size_t i = 0; i < n; ++i)
+            x_t1[i] = x_t0[i] + free[i];
+        return report;
+    };
+
     // Phase 2: sweeps of individual impulses.
     for (int sweep = 0; sweep < options.impulse_sweeps; ++sweep) {
         const std::vector<Contact> contacts = resolver.detect(d);
         if (sweep == 0)
             report.collisions_first_sweep = static_cast<int>(contacts.size());
-        if (contacts.empty()) {
-            // Verified collision-free: done without impact zones.
-            for (size_t i = 0; i < n; ++i)
-                x_t1[i] = x_t0[i] + d[i];
-            return report;
-        }
+        if (contacts.empty())
+            return finish(d, requested);  // verified collision-free without impact zones
         for (const Contact& c : contacts)
             report.impulses += apply_impulse(c, inv, d) ? 1 : 0;
     }
@@ -585,10 +685,12 @@ CollisionReport resolve_collisions(const SurfaceMesh& mesh, const std::vector<Ve
     for (int attempt = 0; attempt <= options.max_step_shortenings; ++attempt) {
         std::vector<Vec3> trial = d;
         if (resolver.impact_zones(trial, report) || resolver.rigid_zones(trial, report)) {
-            for (size_t i = 0; i < n; ++i)
-                x_t1[i] = x_t0[i] + trial[i];
             report.motion_fraction = fraction;
-            return report;
+            std::vector<Vec3> reference = requested;
+            if (fraction != 1.0)
+                for (size_t i = 0; i < n; ++i)
+                    reference[i] = fraction * requested[i];
+            return finish(trial, reference);
         }
         // Fallback: shorten the whole motion and try again from the requested one.
         ++report.step_shortenings;

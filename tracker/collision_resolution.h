@@ -36,6 +36,16 @@ struct CollisionOptions {
     /// few vertices, and assembling them asked for more memory than the machine had. A larger
     /// zone goes to the rigid-zone fallback (CollisionReport::oversized_zone_solves).
     int max_zone_matrix_entries = 20'000'000;
+    /// Volume-aware response (issue 34; not in the paper): once the motion is collision-free,
+    /// give each closed component back the volume collision handling changed (the component's
+    /// volume under the requested motion minus its volume after the response) by the smallest
+    /// mass-weighted displacement of the vertices the response left alone
+    /// (volume_constraint.h). The corrected motion is kept only when CCD verifies it free;
+    /// otherwise the verified uncorrected motion stays.
+    bool preserve_volume = false;
+    /// Attempts of that correction, ≥ 1: each one CCD rejects takes the vertices of the
+    /// collisions it found out of the next attempt.
+    int max_volume_rounds = 3;
     /// Checked before every detection round: throws meniscus::Cancelled once requested.
     CancellationToken cancel;
     void validate() const;                ///< throws std::invalid_argument naming the field
@@ -55,6 +65,14 @@ struct CollisionReport {
     int rigid_zone_iterations = 0;
     int step_shortenings = 0;
     int broad_phases = 0;  ///< candidate-pair sets built (each a broad phase over the mesh)
+    /// Corrected motions CCD checked (CollisionOptions::preserve_volume); the last one was kept
+    /// when volume_restored.
+    int volume_rounds = 0;
+    bool volume_restored = false;  ///< a volume correction was verified and applied
+    /// Σ over closed components of |V(response) − V(requested)| before and after the volume
+    /// correction (m³); both 0 when preserve_volume is off.
+    double volume_error_before = 0.0;
+    double volume_error_after = 0.0;
     /// Fraction of the requested motion actually applied (1 unless step shortening was used;
     /// 0 when every fallback failed and the mesh stayed at x_t0).
     double motion_fraction = 1.0;
