@@ -268,18 +268,25 @@ TEST(Viscosity, StopsWhenCancelled) {
                     .converged);
 }
 
+/// A cube of n³ cells of edge 1/n whose face velocities are a deterministic scramble (every
+/// mode present), with zero normal velocity on the walls.
+MacGrid scrambled_grid(int n) {
+    MacGrid grid(n, n, n, 1.0 / n);
+    for (int axis = 0; axis < 3; ++axis) {
+        std::vector<double>& u = grid.velocity(axis).storage();
+        for (std::size_t f = 0; f < u.size(); ++f)
+            u[f] = std::sin(0.37 * static_cast<double>(f) + axis);
+    }
+    grid.zero_wall_normal_velocity();
+    return grid;
+}
+
 TEST(FluidViscosity, ReusedSolverRebuildsForANewInterfaceOrStep) {
     // The solver keeps its operator while φ and Δt stay the same (the coupled scheme's Uzawa
     // passes); any change must rebuild it: every reused solve equals a fresh solver's, bit for bit.
     const int n = 10;
     const double dx = 1.0 / n;
-    MacGrid start(n, n, n, dx);
-    for (int axis = 0; axis < 3; ++axis) {
-        std::vector<double>& u = start.velocity(axis).storage();
-        for (std::size_t f = 0; f < u.size(); ++f)
-            u[f] = std::sin(0.37 * static_cast<double>(f) + axis);
-    }
-    start.zero_wall_normal_velocity();
+    const MacGrid start = scrambled_grid(n);
     PhaseOptions phases;
     phases.rho_liquid = 1000.0;
     phases.rho_gas = 1.0;
@@ -324,13 +331,7 @@ TEST(FluidViscosity, MultigridPreconditionerGivesTheJacobiAnswerInFewerIteration
     // wall of each type.
     const int n = 16;
     const double dx = 1.0 / n;
-    MacGrid start(n, n, n, dx);
-    for (int axis = 0; axis < 3; ++axis) {
-        std::vector<double>& u = start.velocity(axis).storage();
-        for (std::size_t f = 0; f < u.size(); ++f)
-            u[f] = std::sin(0.37 * static_cast<double>(f) + axis);
-    }
-    start.zero_wall_normal_velocity();
+    const MacGrid start = scrambled_grid(n);
     InterfaceInput interface(start);
     for (int k = 0; k < n; ++k)
         for (int j = 0; j < n; ++j)
