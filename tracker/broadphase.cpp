@@ -405,20 +405,19 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
         m_ids[pos] = static_cast<int>(i);
         m_cell_boxes[pos] = boxes[i];
     }
-    m_slot_range.assign(slots, {0, 0});
-    for (size_t slot = 0; slot < slots; ++slot)
-        if (slot_cell[slot] >= 0) {
-            const Cell& cell = m_cells[static_cast<size_t>(slot_cell[slot])];
-            m_slot_range[slot] = {cell.begin, cell.end};
-        }
+    m_slot_cell = std::move(slot_cell);
+    m_cell_union.resize(m_cells.size());  // default: empty
+    for (size_t c = 0; c < m_cells.size(); ++c)
+        for (int k = m_cells[c].begin; k < m_cells[c].end; ++k)
+            m_cell_union[c].extend(m_cell_boxes[static_cast<size_t>(k)]);
 }
 
-std::pair<int, int> LooseGrid::find_cell(std::int64_t key) const {
+int LooseGrid::find_cell(std::int64_t key) const {
     const size_t mask = m_slot_key.size() - 1;
     size_t slot = mix(key) & mask;
     while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
         slot = (slot + 1) & mask;
-    return m_slot_key[slot] == -1 ? std::pair<int, int>{0, 0} : m_slot_range[slot];
+    return m_slot_key[slot] == -1 ? -1 : m_slot_cell[slot];
 }
 
 template <typename F>
@@ -431,13 +430,24 @@ void LooseGrid::visit(size_t task, F&& f) const {
                 if (boxes_overlap(box_a, m_cell_boxes[static_cast<size_t>(b)]))
                     f(m_ids[static_cast<size_t>(a)], m_ids[static_cast<size_t>(b)]);
         }
+        // Against each neighbour only the elements that reach the neighbour's bounding box:
+        // most of a cell's elements lie away from the face, edge or corner it shares.
+        const Box3d& union_a = m_cell_union[task];
         for (const auto& offset : HALF_STENCIL) {
-            const auto [begin, end] = find_cell(
+            const int nb = find_cell(
                 cell_key(cell.coords + Eigen::Array3i(offset[0], offset[1], offset[2])));
-            for (int b = begin; b < end; ++b) {
-                const Box3d& box_b = m_cell_boxes[static_cast<size_t>(b)];
-                for (int a = cell.begin; a < cell.end; ++a)
-                    if (boxes_overlap(m_cell_boxes[static_cast<size_t>(a)], box_b))
+            if (nb < 0)
+                continue;
+            const Box3d& union_b = m_cell_union[static_cast<size_t>(nb)];
+            if (!boxes_overlap(union_a, union_b))
+                continue;
+            const Cell& other = m_cells[static_cast<size_t>(nb)];
+            for (int a = cell.begin; a < cell.end; ++a) {
+                const Box3d& box_a = m_cell_boxes[static_cast<size_t>(a)];
+                if (!boxes_overlap(box_a, union_b))
+                    continue;
+                for (int b = other.begin; b < other.end; ++b)
+                    if (boxes_overlap(box_a, m_cell_boxes[static_cast<size_t>(b)]))
                         f(m_ids[static_cast<size_t>(a)], m_ids[static_cast<size_t>(b)]);
             }
         }
@@ -457,8 +467,11 @@ void LooseGrid::visit(size_t task, F&& f) const {
         for (int z = lo.z(); z <= hi.z(); ++z)
             for (int y = lo.y(); y <= hi.y(); ++y)
                 for (int x = lo.x(); x <= hi.x(); ++x) {
-                    const auto [begin, end] = find_cell(cell_key(Eigen::Array3i(x, y, z)));
-                    for (int k = begin; k < end; ++k)
+                    const int c = find_cell(cell_key(Eigen::Array3i(x, y, z)));
+                    if (c < 0)
+                        continue;
+                    const Cell& cell = m_cells[static_cast<size_t>(c)];
+                    for (int k = cell.begin; k < cell.end; ++k)
                         if (boxes_overlap(box_o, m_cell_boxes[static_cast<size_t>(k)]))
                             f(io, m_ids[static_cast<size_t>(k)]);
                 }
@@ -491,18 +504,14 @@ void LooseGrid::query(const Box3d& box, std::vector<int>& out) const {
         return;
     }
     const Eigen::Array3i lo = lo_d.cast<int>(), hi = hi_d.cast<int>();
-    const size_t mask = m_slot_key.size() - 1;
     for (int z = lo.z(); z <= hi.z(); ++z)
         for (int y = lo.y(); y <= hi.y(); ++y)
             for (int x = lo.x(); x <= hi.x(); ++x) {
-                const std::int64_t key = cell_key(Eigen::Array3i(x, y, z));
-                size_t slot = mix(key) & mask;
-                while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
-                    slot = (slot + 1) & mask;
-                if (m_slot_key[slot] == -1)
+                const int c = find_cell(cell_key(Eigen::Array3i(x, y, z)));
+                if (c < 0 || !boxes_overlap(m_cell_union[static_cast<size_t>(c)], box))
                     continue;
-                const auto [begin, end] = m_slot_range[slot];
-                for (int k = begin; k < end; ++k)
+                const Cell& cell = m_cells[static_cast<size_t>(c)];
+                for (int k = cell.begin; k < cell.end; ++k)
                     if (boxes_overlap(m_cell_boxes[static_cast<size_t>(k)], box))
                         out.push_back(m_ids[static_cast<size_t>(k)]);
             }

@@ -132,15 +132,16 @@ private:
         int begin, end;  // [begin, end) into m_ids
     };
     std::int64_t cell_key(const Eigen::Array3i& c) const;
-    /// Range of ids in the cell with `key` ({0, 0} when empty).
-    std::pair<int, int> find_cell(std::int64_t key) const;
+    /// Index into m_cells of the cell with `key`, −1 when no element lies there.
+    int find_cell(std::int64_t key) const;
     const std::vector<Box3d>& m_boxes;
     double m_cell = 1.0;
     std::vector<int> m_ids;                         // ids grouped by cell
     std::vector<Box3d> m_cell_boxes;                // their boxes, same order (sequential reads)
     std::vector<std::int64_t> m_slot_key;           // flat hash: key per slot (−1 = empty)
-    std::vector<std::pair<int, int>> m_slot_range;  // [begin, end) into m_ids per slot
+    std::vector<int> m_slot_cell;                   // index into m_cells per slot (−1 = empty)
     std::vector<Cell> m_cells;                      // occupied cells, first-appearance order
+    std::vector<Box3d> m_cell_union;                // per cell: the union of its elements' boxes
     std::vector<int> m_oversized;
 };
 

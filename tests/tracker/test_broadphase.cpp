@@ -179,6 +179,56 @@ TEST(BroadPhaseTrianglePairs, EqualBruteForce) {
     }
 }
 
+// The merge search's pairs (the loose grid's self join, each cell against the neighbours its
+// elements reach) equal brute force: on a mesh at rest, with paddings from none to several
+// edge lengths (most edges then oversized), and with `keep` applied to exactly the overlapping
+// pairs.
+TEST(StaticEdgeEdgePairs, EqualBruteForceAtEveryPadding) {
+    const SurfaceMesh m = meshed(
+        make_union({make_sphere({0, 0, 0}, 0.2), make_torus({0.25, 0, 0}, {1, 1, 0}, 0.2, 0.06)}),
+        0.04);
+    for (double padding : {0.0, 0.005, 0.03, 0.3}) {
+        const auto expected = brute_force_edge_edge_pairs(m, m.positions(), m.positions(), padding);
+        const auto found = static_edge_edge_pairs(m, padding, [](int, int) { return true; });
+        EXPECT_EQ(found, expected) << "padding " << padding;
+        // keep() sees each pair once, lower index first, and decides alone what is returned.
+        const auto odd = static_edge_edge_pairs(m, padding, [](int a, int b) {
+            EXPECT_LT(a, b);
+            return (a + b) % 2 == 1;
+        });
+        std::vector<EdgeEdgePair> expected_odd;
+        for (const EdgeEdgePair& p : expected)
+            if ((p.ei + p.ej) % 2 == 1)
+                expected_odd.push_back(p);
+        EXPECT_EQ(odd, expected_odd) << "padding " << padding;
+    }
+}
+
+// Edges of very different lengths (a few far wider than the grid's cells, found through the
+// cells they cover or by a scan) among ordinary ones: still exactly the brute-force pairs.
+TEST(StaticEdgeEdgePairs, EqualBruteForceWithOversizedEdges) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> pos(-1.0, 1.0), size(-0.1, 0.1), coin(0.0, 1.0);
+    std::vector<Vec3> positions;
+    std::vector<Triangle> triangles;
+    for (int k = 0; k < 500; ++k) {
+        const double u = coin(rng);
+        const double scale = u < 0.03 ? 30.0 : u < 0.25 ? 3.0 : 1.0;
+        const Vec3 a(pos(rng), pos(rng), pos(rng));
+        const int base = static_cast<int>(positions.size());
+        positions.push_back(a);
+        positions.push_back(a + scale * Vec3(size(rng), size(rng), size(rng)));
+        positions.push_back(a + scale * Vec3(size(rng), size(rng), size(rng)));
+        triangles.push_back({base, base + 1, base + 2});
+    }
+    const SurfaceMesh m(positions, triangles);
+    for (double padding : {0.0, 0.02}) {
+        const auto expected = brute_force_edge_edge_pairs(m, m.positions(), m.positions(), padding);
+        EXPECT_EQ(static_edge_edge_pairs(m, padding, [](int, int) { return true; }), expected)
+            << "padding " << padding;
+    }
+}
+
 TEST(MeshIntersections, GeneratedMeshesAreIntersectionFree) {
     for (const auto& shape :
          {make_sphere({0, 0, 0}, 0.3), make_torus({0, 0, 0}, {0, 0, 1}, 0.3, 0.05),

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <chrono>
 #include <cmath>
@@ -152,33 +153,56 @@ std::vector<std::vector<int>> singular_vertex_fans(const SurfaceMesh& mesh, int 
 }
 
 /// True when vi's triangles form one fan joined through manifold edges (each of its edges has
-/// two triangles): the common case, which vertex_fans() would report as a single fan, decided
-/// by walking once around vi instead of by union-find.
+/// two triangles): the common case, which vertex_fans() would report as a single fan. Decided on
+/// vi's link, from the triangles' vertices alone: each triangle (vi, a, b), in its orientation,
+/// links a to b, and one consistently oriented manifold fan is exactly a link in which every
+/// neighbour starts one link and ends one, all on a single cycle. (Then each edge (vi, a) lies in
+/// the two triangles where a starts and ends a link, and in no other, since every triangle of
+/// that edge contains vi.) A fan this misses — oriented inconsistently — only costs the caller
+/// the full analysis: false is always safe.
 bool one_manifold_fan(const SurfaceMesh& mesh, int vi) {
     const std::vector<int>& tris = mesh.vertex_triangles(vi);
-    if (tris.empty())
+    const size_t n = tris.size();
+    if (n < 3)
         return false;
-    for (int ei : mesh.vertex_edges(vi))
-        if (mesh.edge_triangles(ei).size() != 2)
-            return false;
-    int current = tris[0];
-    int came_through = INVALID_INDEX;
-    size_t visited = 0;
-    do {
-        ++visited;
-        int next_edge = INVALID_INDEX;
-        for (int ei : mesh.triangle_edges(current)) {
-            const Edge& e = mesh.edge(ei);
-            if ((e[0] == vi || e[1] == vi) && ei != came_through) {
-                next_edge = ei;
+    constexpr size_t LOCAL = 16;  // valence of almost every vertex; larger fans take the heap
+    std::array<int, LOCAL> from_local{}, to_local{};
+    std::vector<int> from_heap, to_heap;
+    int* from = from_local.data();
+    int* to = to_local.data();
+    if (n > LOCAL) {
+        from_heap.resize(n);
+        to_heap.resize(n);
+        from = from_heap.data();
+        to = to_heap.data();
+    }
+    for (size_t k = 0; k < n; ++k) {
+        const Triangle& t = mesh.triangle(tris[k]);
+        const int at = t[0] == vi ? 0 : t[1] == vi ? 1 : 2;
+        from[k] = t[static_cast<size_t>((at + 1) % 3)];
+        to[k] = t[static_cast<size_t>((at + 2) % 3)];
+    }
+    // Every neighbour starts exactly one link: no two links share a start (nor an end).
+    for (size_t i = 0; i < n; ++i)
+        for (size_t j = i + 1; j < n; ++j)
+            if (from[i] == from[j] || to[i] == to[j])
+                return false;
+    // Follow the links from the first: a single cycle through all n returns after n steps.
+    size_t k = 0;
+    for (size_t steps = 1; steps <= n; ++steps) {
+        size_t next = n;
+        for (size_t j = 0; j < n; ++j)
+            if (from[j] == to[k]) {
+                next = j;
                 break;
             }
-        }
-        const std::vector<int>& et = mesh.edge_triangles(next_edge);
-        current = et[0] == current ? et[1] : et[0];
-        came_through = next_edge;
-    } while (current != tris[0] && visited <= tris.size());
-    return current == tris[0] && visited == tris.size();
+        if (next == n)
+            return false;  // a link ends where none starts: an open fan (boundary or fin)
+        k = next;
+        if (k == 0)
+            return steps == n;
+    }
+    return false;
 }
 
 Vec3 fan_centroid(const SurfaceMesh& mesh, const std::vector<int>& fan, int vi) {
