@@ -15,7 +15,8 @@ BUILD_DIR=${MENISCUS_BUILD_DIR:-build}
 SANITIZE_BUILD_DIR=${MENISCUS_SANITIZE_BUILD_DIR:-build-sanitize}
 # The sanitizer pass runs every test that takes under about 10 s in the Release suite: all unit
 # tests of tracker, fluid, coupling and app, the command-line robustness tests (signals, checked
-# writes, refused input) and 2 of the 8 fuzz shards (80 cases). It leaves out what runs the same
+# writes, refused input) and 2 of the 8 fuzz shards (80 cases; shards 0 and 7, 20 and 12 s in the
+# Release suite, where shard 1 took 214 s under the sanitizers). It leaves out what runs the same
 # code for minutes (several times longer under the sanitizers): the validation suite, the shipped
 # scene runs and physics checks, convergence studies, long stress runs, the render path
 # through Blender and the resume tests that kill runs by the clock (together about 84 % of the
@@ -26,7 +27,7 @@ SANITIZE_EXCLUDE+='|AxisymmetricDumbbell\.(Agrees|Converges|HandlePinches)|Axisy
 SANITIZE_EXCLUDE+='|LevelSetReference\.(SphereFollows|DumbbellPinches)|Simulation\.(MergedDrop|StaticDropSpurious)'
 SANITIZE_EXCLUDE+='|CcdFalsePositives\.NearDegenerate|RemeshAccuracy\.SplitsAtThinFolds|FluidViscosity\.(TwoLayer|Poiseuille)'
 SANITIZE_EXCLUDE+='|FluidSolver\.TaylorGreenVortexDecay|DropMerge\.TwoDrops|SurfaceTension\.(StaticDropThrough|SmoothingReduces)'
-SANITIZE_EXCLUDE+='|FuzzRun.*/[2-7]$|RenderPath|FluidScenes\.TimeDtCapsTheFluidStep'
+SANITIZE_EXCLUDE+='|FuzzRun.*/[1-6]$|RenderPath|FluidScenes\.TimeDtCapsTheFluidStep'
 SANITIZE_EXCLUDE+='|Resume\.(FluidRunKilled|GeometricFlowKilled|OneAndTwoThreads)'
 # Any finding ends the program with exit code 86 (tests then fail); LeakSanitizer included.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-exitcode=86:detect_leaks=1:strict_string_checks=1}
