@@ -172,6 +172,11 @@ void visit_fields(V& v, CouplingOptions& o) {
                 {"quadratic_bspline", coupling::VelocityInterpolation::quadratic_bspline},
                 {"one_sided", coupling::VelocityInterpolation::one_sided}},
                "grid → vertex velocity reconstruction");
+    enum_field(v, "outside_velocity", o.simulation.interpolate.outside,
+               {{"clamp", coupling::OutsideVelocity::clamp},
+                {"mirror", coupling::OutsideVelocity::mirror}},
+               "velocity of mesh vertices outside the domain: clamp (that of the nearest point "
+               "inside) or mirror (across free-slip walls, the reflected flow)");
     v.number("capillary_safety", o.simulation.capillary_safety, Range{0.0, 1.0, true, false}, "",
              "factor on the capillary time-step limit");
 }

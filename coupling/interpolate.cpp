@@ -128,6 +128,8 @@ void InterpolateOptions::validate() const {
         method != VelocityInterpolation::quadratic_bspline &&
         method != VelocityInterpolation::one_sided)
         throw std::invalid_argument("method: expected trilinear, quadratic_bspline or one_sided");
+    if (outside != OutsideVelocity::clamp && outside != OutsideVelocity::mirror)
+        throw std::invalid_argument("outside: expected clamp or mirror");
 }
 
 Eigen::Vector3d sample_grid_velocity(const fluid::MacGrid& grid, const Eigen::Vector3d& x,
@@ -151,8 +153,34 @@ Eigen::Vector3d sample_grid_velocity(const fluid::MacGrid& grid, const Eigen::Ve
 
 std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& grid,
                                                          const tracker::SurfaceMesh& mesh,
-                                                         const InterpolateOptions& options) {
+                                                         const InterpolateOptions& options,
+                                                         const fluid::WallOptions& walls) {
     options.validate();
+    walls.validate();
+    const bool mirror = options.outside == OutsideVelocity::mirror;
+    const Eigen::Vector3d lo = grid.origin();
+    const Eigen::Vector3d hi =
+        lo + grid.dx() * Eigen::Vector3d(grid.nx(), grid.ny(), grid.nz());
+    // The sample of a vertex at x with normal n; outside a free-slip wall (mirror), the sample at
+    // the reflected point and normal with the wall-normal component negated back.
+    const auto sample = [&](Eigen::Vector3d x, Eigen::Vector3d n) {
+        std::array<bool, 3> reflected{};
+        if (mirror)
+            for (int d = 0; d < 3; ++d) {
+                const int side = x[d] < lo[d] ? 0 : x[d] > hi[d] ? 1 : -1;
+                if (side < 0 || walls.at(d, side) != fluid::WallType::free_slip)
+                    continue;
+                const double plane = side == 0 ? lo[d] : hi[d];
+                x[d] = 2.0 * plane - x[d];
+                n[d] = -n[d];
+                reflected[static_cast<size_t>(d)] = true;
+            }
+        Eigen::Vector3d v = sample_grid_velocity(grid, x, options.method, n);
+        for (int d = 0; d < 3; ++d)
+            if (reflected[static_cast<size_t>(d)])
+                v[d] = -v[d];
+        return v;
+    };
     std::vector<tracker::Vec3> velocities(static_cast<size_t>(mesh.num_vertices()),
                                           tracker::Vec3::Zero());
     const std::vector<tracker::Vec3> normals = options.method == VelocityInterpolation::one_sided
@@ -163,9 +191,9 @@ std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& g
             for (int vi = range.begin(); vi != range.end(); ++vi)
                 if (mesh.vertex_alive(vi))
                     velocities[static_cast<size_t>(vi)] =
-                        sample_grid_velocity(grid, mesh.position(vi), options.method,
-                                             normals.empty() ? Eigen::Vector3d::Zero()
-                                                             : normals[static_cast<size_t>(vi)]);
+                        sample(mesh.position(vi), normals.empty()
+                                                      ? Eigen::Vector3d::Zero()
+                                                      : normals[static_cast<size_t>(vi)]);
         });
     return velocities;
 }

@@ -112,7 +112,8 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
 
     // (4) Grid → mesh.
     m_vertex_velocities =
-        interpolate_vertex_velocities(m_fluid.grid(), mesh, m_options.interpolate);
+        interpolate_vertex_velocities(m_fluid.grid(), mesh, m_options.interpolate,
+                                      m_fluid.options().walls);
     for (const tracker::Vec3& v : m_vertex_velocities)
         report.max_vertex_speed = std::max(report.max_vertex_speed, v.norm());
     clock.lap_into(timings.interpolate);

@@ -91,12 +91,17 @@ constexpr double ENRIGHT_QUICK_RETURN_LINF = 0.01;
 /// Measured with the one-sided vertex velocities (coupling/interpolate.h): Δp −0.003 % at 10
 /// and 16 cells per diameter; Lamb frequency −0.3 % at 12 cells per diameter (trilinear:
 /// −4.9 %); Rayleigh–Plateau growth rate −0.6 % at R = 3 cells (trilinear: −5.5 %);
-/// capillary-wave frequency −3.7 % at 16 cells per wavelength (trilinear: −5.0 %).
+/// capillary-wave frequency −3.7 % at 16 cells per wavelength (trilinear: −5.0 %; since then
+/// −2.1 %, below).
 constexpr double B1_JUMP_RELATIVE = 0.02;              ///< docs/validation.md B1 (≥ 16 cells per D)
 constexpr double B1_SPURIOUS_CAPILLARY_NUMBER = 0.05;  ///< max|u| sqrt(ρD/σ); measured 6e-3
 constexpr double B2_QUICK_FREQUENCY_RELATIVE = 0.02;
 constexpr double B3_QUICK_RATE_RELATIVE = 0.03;
-constexpr double B4_QUICK_FREQUENCY_RELATIVE = 0.05;
+/// B4 at 16 cells per wavelength with the mirrored outside velocities (/coupling/outside_velocity
+/// mirror): measured ω −2.1 %, fitted |decay rate| 0.047 1/s; with the clamped ones −2.7 % and
+/// 0.48 1/s (the inviscid wave's amplitude drifted: the slab beyond the side walls kinked).
+constexpr double B4_QUICK_FREQUENCY_RELATIVE = 0.03;
+constexpr double B4_QUICK_DECAY_RATE = 0.2;  ///< 1/s; inviscid: no decay
 /// An oscillation fit must describe the run: rms residual below this fraction of the amplitude.
 constexpr double FIT_RMS_FRACTION = 0.05;
 /// B6 viscous drop (ω₀R²/ν = 20) at 12 cells per diameter against the exact free-drop mode:
@@ -399,6 +404,7 @@ TEST_F(QuickValidation, PartBOscillationsAndGrowthAgainstTheory) {
     const Json& wave = b["B4"]["runs"][0];
     EXPECT_LT(std::abs(wave["frequency_relative_error"].get<double>()),
               B4_QUICK_FREQUENCY_RELATIVE);
+    EXPECT_LT(std::abs(wave["decay_rate"].get<double>()), B4_QUICK_DECAY_RATE);
     EXPECT_LT(wave["rms_residual"].get<double>(),
               FIT_RMS_FRACTION * wave["amplitude"].get<double>());
     for (const char* id : {"B2", "B3", "B4"})

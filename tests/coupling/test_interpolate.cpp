@@ -4,6 +4,7 @@
 #include "coupling/interpolate.h"
 
 #include "tracker/implicit_mesher.h"
+#include "tracker/mesh_measures.h"
 #include "tracker/implicit_shape.h"
 
 #include <gtest/gtest.h>
@@ -187,6 +188,51 @@ TEST(Interpolate, VertexVelocitiesOfAMeshAreExactForALinearFieldAndZeroWhenDead)
         EXPECT_LT(max_error, LINEAR_TOLERANCE);
         EXPECT_EQ(velocity[static_cast<size_t>(dead)], tracker::Vec3::Zero());
     }
+}
+
+TEST(Interpolate, MirrorReflectsTheFlowAcrossFreeSlipWallsAndClampsAtNoSlipOnes) {
+    // A mesh crossing walls (B4's slab past its side walls): with OutsideVelocity::mirror a
+    // vertex beyond a free-slip wall takes the velocity at its mirror point with the wall-normal
+    // component negated (the even/odd continuation a symmetry plane implies); beyond a no-slip
+    // wall it keeps the clamped sample; with `clamp` every vertex keeps the clamped sample.
+    fluid::MacGrid grid(10, 8, 9, 0.1);  // [0, 1] × [0, 0.8] × [0, 0.9]
+    Matrix3d gradient;
+    gradient << 1.5, -0.4, 2.0, 0.3, -2.5, 0.9, -1.1, 0.6, 1.0;
+    set_linear_velocity(grid, Vector3d(0.3, -1.2, 0.7), gradient);
+    fluid::WallOptions walls;  // free-slip but x_max
+    walls.x_max = fluid::WallType::no_slip;
+    const std::vector<Vector3d> x = {{-0.2, 0.4, 0.45}, {0.5, 0.4, 1.1}, {1.25, 0.9, 0.45}};
+    // Where mirroring samples each vertex, and the sign of each component there.
+    const std::vector<Vector3d> image = {{0.2, 0.4, 0.45}, {0.5, 0.4, 0.7}, {1.25, 0.7, 0.45}};
+    const std::vector<Vector3d> sign = {{-1, 1, 1}, {1, 1, -1}, {1, -1, 1}};
+    const tracker::SurfaceMesh mesh({x[0], x[1], x[2]}, {{0, 1, 2}});
+    const std::vector<tracker::Vec3> normals = tracker::area_weighted_vertex_normals(mesh);
+    for (VelocityInterpolation method :
+         {VelocityInterpolation::trilinear, VelocityInterpolation::one_sided}) {
+        InterpolateOptions options;
+        options.method = method;
+        options.outside = OutsideVelocity::mirror;
+        const std::vector<tracker::Vec3> mirrored =
+            interpolate_vertex_velocities(grid, mesh, options, walls);
+        options.outside = OutsideVelocity::clamp;
+        const std::vector<tracker::Vec3> clamped =
+            interpolate_vertex_velocities(grid, mesh, options, walls);
+        for (size_t v = 0; v < 3; ++v) {
+            const Vector3d n = normals[v];
+            const Vector3d expected =
+                sample_grid_velocity(grid, image[v], method, n.cwiseProduct(sign[v]))
+                    .cwiseProduct(sign[v]);
+            EXPECT_LT((mirrored[v] - expected).cwiseAbs().maxCoeff(), 1e-12) << "vertex " << v;
+            EXPECT_LT((clamped[v] - sample_grid_velocity(grid, x[v], method, n)).cwiseAbs().maxCoeff(),
+                      1e-12)
+                << "vertex " << v;
+        }
+        // The two differ wherever a vertex is beyond a free-slip wall.
+        EXPECT_GT((mirrored[0] - clamped[0]).norm(), 0.1);
+    }
+    InterpolateOptions bad;
+    bad.outside = static_cast<OutsideVelocity>(5);
+    EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
 TEST(Interpolate, QuadraticBSplineIsSmootherThanTrilinear) {
