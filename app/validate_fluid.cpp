@@ -513,7 +513,8 @@ struct Runner : CaseContext {
               "both), " << WAVE_THICKNESS_CELLS
            << " cells thick in y, mean interface at depth λ/2 in a box of height λ. The liquid "
               "slab is the wavy half-space cut by a box reaching 6 cells beyond the side and "
-              "bottom walls (vertices outside the domain take the velocity at the clamped point). "
+              "bottom walls (a vertex outside the domain takes the flow mirrored across the free-slip "
+              "wall, /coupling/outside_velocity mirror). "
               "Amplitude a(t): least-squares cos(kx) mode of the top surface's vertices in the "
               "domain, fitted over "
            << fmt(end / period, "%.2g")
@@ -533,10 +534,12 @@ struct Runner : CaseContext {
                << fmt(100.0 * r["volume_drift"].get<double>(), "%.3f %%") << " | "
                << r["max_intersecting_pairs"] << " |\n";
         md << "\nA peak max|u| far above a₀ω₀ (the linear wave's velocity scale) is a spurious "
-              "flow. The sub-grid tension (coupling/subgrid_rate, default 0.05) slows this wave: at "
-              "32 cells per wavelength over the first 1.65 periods, −1.1 %, −1.2 %, −2.5 % and "
-              "−4.7 % at β = 0, 0.01, 0.02, 0.05 (without it the flow turns spurious after about "
-              "1.3 periods). Reference (Basilisk, viscous La = 3000 against Prosperetti): RMS "
+              "flow. Two causes once slowed this wave at 32 cells per wavelength: the sub-grid "
+              "tension's first-order high-pass I − S (−4.7 % over the first 1.65 periods, −1.1 % "
+              "without the sub-grid tension; now (I − S)²) and the slab beyond the side walls "
+              "moving with the clamped velocity instead of the mirrored one (it kinked at the "
+              "walls: over 3 periods −4.1 % with the amplitude peaking at 1.32× the start; now "
+              "−0.16 %, peaks 0.99–1.06×). Reference (Basilisk, viscous La = 3000 against Prosperetti): RMS "
               "error 0.139, 0.0243, 0.0069, 0.0024 at 8, 16, 32, 64 points per wavelength. Plot: "
               "b4_wave.png.\n\n";
     }
