@@ -25,6 +25,28 @@ std::vector<Vec3> randomly_moved(const SurfaceMesh& m, double amplitude, unsigne
     return x;
 }
 
+/// `count` separate random triangles in [−half_width, half_width]³ of mixed sizes: most with
+/// corners within 0.1 of the first on each axis, 22 % three times that (oversized for the grids'
+/// cells), 3 % `huge_scale` times that (spanning many cells).
+SurfaceMesh scattered_triangles(unsigned seed, int count, double half_width, double huge_scale) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> pos(-half_width, half_width), size(-0.1, 0.1),
+        coin(0.0, 1.0);
+    std::vector<Vec3> positions;
+    std::vector<Triangle> triangles;
+    for (int k = 0; k < count; ++k) {
+        const double u = coin(rng);
+        const double scale = u < 0.03 ? huge_scale : u < 0.25 ? 3.0 : 1.0;
+        const Vec3 a(pos(rng), pos(rng), pos(rng));
+        const int base = static_cast<int>(positions.size());
+        positions.push_back(a);
+        positions.push_back(a + scale * Vec3(size(rng), size(rng), size(rng)));
+        positions.push_back(a + scale * Vec3(size(rng), size(rng), size(rng)));
+        triangles.push_back({base, base + 1, base + 2});
+    }
+    return SurfaceMesh(positions, triangles);
+}
+
 template <typename Pair>
 bool includes(std::vector<Pair> super, std::vector<Pair> sub) {
     std::sort(super.begin(), super.end());
@@ -121,21 +143,7 @@ TEST(SpatialHash, RandomUpdatesMatchBruteForce) {
 // cover too many) among ordinary ones. Graded meshes (A4 with thin-sheet sizing) have many
 // edges a little wider than the cell. Here: separate random triangles of mixed sizes.
 TEST(BroadPhaseTrianglePairs, EqualBruteForceWithOversizedTriangles) {
-    std::mt19937 rng(11);
-    std::uniform_real_distribution<double> pos(-2.0, 2.0), size(-0.1, 0.1), coin(0.0, 1.0);
-    std::vector<Vec3> positions;
-    std::vector<Triangle> triangles;
-    for (int k = 0; k < 600; ++k) {
-        const double u = coin(rng);
-        const double scale = u < 0.03 ? 40.0 : u < 0.25 ? 3.0 : 1.0;  // huge, oversized, ordinary
-        const Vec3 a(pos(rng), pos(rng), pos(rng));
-        const int base = static_cast<int>(positions.size());
-        positions.push_back(a);
-        positions.push_back(a + scale * Vec3(size(rng), size(rng), size(rng)));
-        positions.push_back(a + scale * Vec3(size(rng), size(rng), size(rng)));
-        triangles.push_back({base, base + 1, base + 2});
-    }
-    const SurfaceMesh m(positions, triangles);
+    const SurfaceMesh m = scattered_triangles(11, 600, 2.0, 40.0);
     const BroadPhase broad(m, 0.0);
     const std::vector<TrianglePair> found = broad.triangle_pairs();
     std::vector<TrianglePair> expected;
@@ -207,21 +215,7 @@ TEST(StaticEdgeEdgePairs, EqualBruteForceAtEveryPadding) {
 // Edges of very different lengths (a few far wider than the grid's cells, found through the
 // cells they cover or by a scan) among ordinary ones: still exactly the brute-force pairs.
 TEST(StaticEdgeEdgePairs, EqualBruteForceWithOversizedEdges) {
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<double> pos(-1.0, 1.0), size(-0.1, 0.1), coin(0.0, 1.0);
-    std::vector<Vec3> positions;
-    std::vector<Triangle> triangles;
-    for (int k = 0; k < 500; ++k) {
-        const double u = coin(rng);
-        const double scale = u < 0.03 ? 30.0 : u < 0.25 ? 3.0 : 1.0;
-        const Vec3 a(pos(rng), pos(rng), pos(rng));
-        const int base = static_cast<int>(positions.size());
-        positions.push_back(a);
-        positions.push_back(a + scale * Vec3(size(rng), size(rng), size(rng)));
-        positions.push_back(a + scale * Vec3(size(rng), size(rng), size(rng)));
-        triangles.push_back({base, base + 1, base + 2});
-    }
-    const SurfaceMesh m(positions, triangles);
+    const SurfaceMesh m = scattered_triangles(5, 500, 1.0, 30.0);
     for (double padding : {0.0, 0.02}) {
         const auto expected = brute_force_edge_edge_pairs(m, m.positions(), m.positions(), padding);
         EXPECT_EQ(static_edge_edge_pairs(m, padding, [](int, int) { return true; }), expected)
