@@ -113,9 +113,11 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
              "", "relative residual of the implicit viscosity solve");
     enum_field(v, "viscosity_weights", o.viscosity.weights,
                {{"sharp", fluid::ViscosityWeights::sharp},
-                {"volume_fraction", fluid::ViscosityWeights::volume_fraction}},
-               "two_phase μ next to the interface: `sharp` (cell phase, harmonic mean on edges) "
-               "or `volume_fraction` (blended by the liquid fraction of each control volume)");
+                {"volume_fraction", fluid::ViscosityWeights::volume_fraction},
+                {"pointwise", fluid::ViscosityWeights::pointwise}},
+               "two_phase μ next to the interface: `sharp` (cell phase, harmonic mean on edges), "
+               "`volume_fraction` (blended by the liquid fraction of each control volume) or "
+               "`pointwise` (the phase at each cell centre and edge midpoint)");
     enum_field(v, "viscosity_preconditioner", o.viscosity.preconditioner,
                {{"multigrid", fluid::ViscousPreconditioner::multigrid},
                 {"jacobi", fluid::ViscousPreconditioner::jacobi}},
@@ -177,8 +179,14 @@ void visit_fields(V& v, CouplingOptions& o) {
                 {"mirror", coupling::OutsideVelocity::mirror}},
                "velocity of mesh vertices outside the domain: clamp (that of the nearest point "
                "inside) or mirror (across free-slip walls, the reflected flow)");
-    v.number("capillary_safety", o.simulation.capillary_safety, Range{0.0, 1.0, true, false}, "",
-             "factor on the capillary time-step limit");
+    v.number("capillary_safety", o.simulation.capillary_safety,
+             Range{0.0, coupling::MAX_IMPLICIT_CAPILLARY_SAFETY, true, false}, "",
+             "factor on the capillary time-step limit (above 1 only with implicit_tension)");
+    v.number("implicit_tension", o.simulation.implicit_tension, Range::between(0.0, 1.0), "",
+             "semi-implicit surface tension: the fraction θ of the step ahead at which the "
+             "surface's tension is taken, a surface viscosity θσΔt in the viscous solve (0 = "
+             "explicit; 1 is the validated value, 0.5 went unstable at 3× the limit); needs "
+             "velocity_interpolation trilinear");
 }
 
 template <typename V>
@@ -791,6 +799,18 @@ Scene parse_scene(const std::string& json_text, const std::string& source,
         } catch (const std::invalid_argument& e) {
             throw SceneError(std::string("/fluid/") + e.what());
         }
+        if (scene.coupling.simulation.implicit_tension > 0.0 &&
+            scene.coupling.simulation.interpolate.method !=
+                coupling::VelocityInterpolation::trilinear)
+            throw SceneError(
+                "/coupling/implicit_tension: needs /coupling/velocity_interpolation "
+                "\"trilinear\" (with the default one_sided velocities a drop at 3× the "
+                "capillary limit grows unstable)");
+        if (scene.coupling.simulation.implicit_tension == 0.0 &&
+            scene.coupling.simulation.capillary_safety > 1.0)
+            throw SceneError(
+                "/coupling/capillary_safety: above 1 the explicit surface tension is unstable; "
+                "set /coupling/implicit_tension > 0 (e.g. 1) to go past the capillary limit");
         if (scene.flow.type == "fluid" && scene.coupling.edge_length_cells > 0.0)
             scene.surface.edge_length =
                 scene.coupling.edge_length_cells * scene.domain.size.x() / scene.domain.cells;

@@ -63,6 +63,8 @@ constexpr double WAVE_AMPLITUDE = 0.01;
 constexpr double WAVE_THICKNESS_CELLS = 4.0;
 /// B1: pressure samples this many cells away from the interface.
 constexpr double B1_WELL_CELLS = 3.0;
+/// Δt of the semi-implicit runs in units of the capillary limit (issue: ≥ 3×).
+constexpr double IMPLICIT_DT_FACTOR = 3.0;
 
 struct Runner : CaseContext {
     /// Δt factors of a study's coarsest row (the solver's own Δt first); the other rows run at the
@@ -71,6 +73,45 @@ struct Runner : CaseContext {
         if (row == 0 && (options.full || quick_too))
             return {1.0, 0.5, 0.25};
         return {1.0};
+    }
+
+    /// A run of a study: its Δt factor, whether the surface tension is semi-implicit, and
+    /// whether it belongs to the implicit-tension comparison (trilinear vertex velocities, which
+    /// /coupling/implicit_tension needs) instead of the study.
+    struct Variant {
+        double factor = 1.0;
+        bool implicit = false;
+        bool comparison = false;
+    };
+    /// factors_of(), and on the coarsest row the comparison pair: explicit at the solver's own Δt
+    /// and semi-implicit (/coupling/implicit_tension 1) at IMPLICIT_DT_FACTOR × the capillary
+    /// limit, both with trilinear vertex velocities (kept out of the study; in quick mode only
+    /// where `compare_quick`).
+    std::vector<Variant> variants_of(size_t row, bool quick_too = false,
+                                     bool compare_quick = true) const {
+        std::vector<Variant> variants;
+        for (double factor : factors_of(row, quick_too))
+            variants.push_back({factor, false, false});
+        if (row == 0 && (options.full || compare_quick)) {
+            variants.push_back({1.0, false, true});
+            variants.push_back({IMPLICIT_DT_FACTOR, true, true});
+        }
+        return variants;
+    }
+    /// Sets the variant's time step, tension treatment and interpolation on a case's scene.
+    static void apply_variant(Json& j, const Variant& v) {
+        j["coupling"]["capillary_safety"] = v.factor;
+        j["coupling"]["implicit_tension"] = v.implicit ? 1.0 : 0.0;
+        if (v.comparison)
+            j["coupling"]["velocity_interpolation"] = "trilinear";
+        else
+            j["coupling"].erase("velocity_interpolation");
+    }
+    static std::string variant_text(const Variant& v) {
+        if (!v.comparison)
+            return dt_factor_text(v.factor);
+        return dt_factor_text(v.factor) + (v.implicit ? ", implicit" : ", explicit") +
+               " tension, trilinear velocities";
     }
 
     // ---- B1 ----
@@ -83,7 +124,7 @@ struct Runner : CaseContext {
         const double capillary_time = std::sqrt(RHO_L * std::pow(diameter, 3) / SIGMA);
         const double end = options.full ? 0.010 : 0.002;
         const double laplace = 2.0 * SIGMA / DROP_R;
-        Json runs = Json::array();
+        Json runs = Json::array(), implicit_runs = Json::array();
         Study study{"pressure jump Δp", "Pa", {}};
         for (size_t row = 0; row < resolutions.size(); ++row) {
             const int cpd = resolutions[row];
@@ -98,8 +139,9 @@ struct Runner : CaseContext {
                              {{"type", "sphere"},
                               {"center", {centre.x(), centre.y(), centre.z()}},
                               {"radius", DROP_R}}}};
-            for (double factor : factors_of(row, true)) {
-                j["coupling"]["capillary_safety"] = factor;
+            for (const Variant& variant : variants_of(row, true)) {
+                const double factor = variant.factor;
+                apply_variant(j, variant);
                 Scene scene = scene_from(j);
                 scene.tracker.verify_intersection_free = true;
                 coupling::Simulation sim = make_fluid_simulation(scene);
@@ -125,10 +167,11 @@ struct Runner : CaseContext {
                 };
                 const FluidRunRecord r = run_sampled(sim, end, sample);
                 const std::string what = "B1 " + std::to_string(cpd) + " cells per diameter, " +
-                                         dt_factor_text(factor);
+                                         variant_text(variant);
                 check(what, r);
-                study.add(cpd, dx,
-                          {factor, r.first_dt, jump.back(), laplace, r.steps, r.wall_seconds});
+                if (!variant.comparison)
+                    study.add(cpd, dx,
+                              {factor, r.first_dt, jump.back(), laplace, r.steps, r.wall_seconds});
                 const double peak_speed = series_peak(r.max_speed);
                 const double scale = std::sqrt(RHO_L * diameter / SIGMA);
                 Json run = run_summary(r);
@@ -150,10 +193,12 @@ struct Runner : CaseContext {
                 log(what + ": Δp " + fmt(jump.back()) + " Pa (2σ/R " + fmt(laplace) +
                     "), max|u| " + fmt(r.max_speed.back()) + " m/s, " +
                     fmt(r.wall_seconds, "%.0f") + " s");
-                runs.push_back(run);
+                run["implicit_tension"] = variant.implicit;
+                (variant.comparison ? implicit_runs : runs).push_back(run);
             }
         }
         out.results["B1"] = {{"runs", runs},
+                             {"implicit_runs", implicit_runs},
                              {"t_end", end},
                              {"velocity_scale", std::sqrt(SIGMA / (RHO_L * diameter))},
                              {"capillary_time", capillary_time},
@@ -183,6 +228,10 @@ struct Runner : CaseContext {
               "codes reach max|u|·sqrt(ρD/σ) < 1e-6 at 25 cells per diameter with exact "
               "curvature. Plot: b1_spurious.png (spurious currents, and Δp's error against "
               "resolution).\n\n";
+        md << implicit_markdown(
+            implicit_runs, "cells_per_diameter",
+            {{"Δp (Pa)", "jump", "%.5g"},
+             {"peak max|u|·sqrt(ρD/σ)", "capillary_number_peak", "%.3e"}});
     }
 
     // ---- B2 ----
@@ -194,7 +243,7 @@ struct Runner : CaseContext {
         const double tau = DROP_R * DROP_R / (1.0 * 5.0 * (MU_L / RHO_L));
         // Quick: 1.3 periods (the fit needs one full period); full: 1.5.
         const double end = (options.full ? 1.5 : 1.3) * period;
-        Json runs = Json::array();
+        Json runs = Json::array(), implicit_runs = Json::array();
         Study study{"frequency ω", "1/s", {}};
         for (size_t row = 0; row < resolutions.size(); ++row) {
             const int cpd = resolutions[row];
@@ -208,8 +257,11 @@ struct Runner : CaseContext {
                              {{"type", "ellipsoid"},
                               {"center", {box / 2, box / 2, box / 2}},
                               {"radii", {a, b, b}}}}};
-            for (double factor : factors_of(row)) {
-                j["coupling"]["capillary_safety"] = factor;
+            // Quick mode leaves B2's comparison out: its semi-implicit run is the slowest of the quick
+            // suite (62 s: the viscous solve carries the surface term at density ratio 830).
+            for (const Variant& variant : variants_of(row, false, false)) {
+                const double factor = variant.factor;
+                apply_variant(j, variant);
                 Scene scene = scene_from(j);
                 scene.tracker.verify_intersection_free = true;
                 coupling::Simulation sim = make_fluid_simulation(scene);
@@ -221,12 +273,13 @@ struct Runner : CaseContext {
                 };
                 const FluidRunRecord r = run_sampled(sim, end, sample);
                 const std::string what = "B2 " + std::to_string(cpd) + " cells per diameter, " +
-                                         dt_factor_text(factor);
+                                         variant_text(variant);
                 check(what, r);
                 const OscillationFit fit =
                     fit_damped_oscillation(r.t, deformation, 0.5 * omega, 1.5 * omega);
-                study.add(cpd, box / cells,
-                          {factor, r.first_dt, fit.omega, omega, r.steps, r.wall_seconds});
+                if (!variant.comparison)
+                    study.add(cpd, box / cells,
+                              {factor, r.first_dt, fit.omega, omega, r.steps, r.wall_seconds});
                 Json run = run_summary(r);
                 run.update({{"cells_per_diameter", cpd},
                             {"dt_factor", factor},
@@ -239,10 +292,12 @@ struct Runner : CaseContext {
                 run["series"]["deformation"] = deformation;
                 log(what + ": period " + fmt(1e3 * 2.0 * M_PI / fit.omega) + " ms (Lamb " +
                     fmt(1e3 * period) + "), " + fmt(r.wall_seconds, "%.0f") + " s");
-                runs.push_back(run);
+                run["implicit_tension"] = variant.implicit;
+                (variant.comparison ? implicit_runs : runs).push_back(run);
             }
         }
         out.results["B2"] = {{"runs", runs},
+                             {"implicit_runs", implicit_runs},
                              {"lamb_omega", omega},
                              {"lamb_period", period},
                              {"viscous_decay_time", tau},
@@ -276,6 +331,8 @@ struct Runner : CaseContext {
         md << "\nTarget: the frequency within 2 % at 25 cells per diameter. Reference (Basilisk, "
               "2D analogue): +1.4 %, −0.5 %, 0.1 %, 0.1 % frequency error at 6.4, 12.8, 25.6, "
               "51.2 cells per diameter. Plot: b2_oscillation.png.\n\n";
+        md << implicit_markdown(implicit_runs, "cells_per_diameter",
+                                {{"ω (1/s)", "omega", "%.5g"}, {"γ (1/s)", "decay_rate", "%.3g"}});
     }
 
     // ---- B3 ----
@@ -438,7 +495,7 @@ struct Runner : CaseContext {
         const double period = 2.0 * M_PI / omega;
         const double end = (options.full ? 3.0 : 1.5) * period;
         const double amplitude0 = WAVE_AMPLITUDE * WAVE_LAMBDA;
-        Json runs = Json::array();
+        Json runs = Json::array(), implicit_runs = Json::array();
         Study study{"frequency ω", "1/s", {}};
         for (size_t row = 0; row < resolutions.size(); ++row) {
             const int cells = resolutions[row];
@@ -466,8 +523,9 @@ struct Runner : CaseContext {
                     {{"type", "box"},
                      {"min", {-m, -m, -m}},
                      {"max", {WAVE_LAMBDA + m, thickness + m, height - 0.25 * height}}}}}}}};
-            for (double factor : factors_of(row)) {
-                j["coupling"]["capillary_safety"] = factor;
+            for (const Variant& variant : variants_of(row)) {
+                const double factor = variant.factor;
+                apply_variant(j, variant);
                 Scene scene = scene_from(j);
                 scene.tracker.verify_intersection_free = true;
                 coupling::Simulation sim = make_fluid_simulation(scene);
@@ -480,10 +538,12 @@ struct Runner : CaseContext {
                 };
                 const FluidRunRecord r = run_sampled(sim, end, sample);
                 const std::string what = "B4 " + std::to_string(cells) + " cells per wavelength, " +
-                                         dt_factor_text(factor);
+                                         variant_text(variant);
                 check(what, r);
                 const OscillationFit fit = fit_damped_oscillation(r.t, a, 0.5 * omega, 1.5 * omega);
-                study.add(cells, dx, {factor, r.first_dt, fit.omega, omega, r.steps, r.wall_seconds});
+                if (!variant.comparison)
+                    study.add(cells, dx,
+                              {factor, r.first_dt, fit.omega, omega, r.steps, r.wall_seconds});
                 Json run = run_summary(r);
                 run.update({{"cells_per_wavelength", cells},
                             {"dt_factor", factor},
@@ -498,10 +558,12 @@ struct Runner : CaseContext {
                 run["final_speed_over_a0_omega0"] = r.max_speed.back() / (amplitude0 * omega);
                 log(what + ": ω " + fmt(fit.omega) + " (ω₀ " + fmt(omega) + "), " +
                     fmt(r.wall_seconds, "%.0f") + " s");
-                runs.push_back(run);
+                run["implicit_tension"] = variant.implicit;
+                (variant.comparison ? implicit_runs : runs).push_back(run);
             }
         }
         out.results["B4"] = {{"runs", runs},
+                             {"implicit_runs", implicit_runs},
                              {"omega0", omega},
                              {"omega_deep", omega_deep},
                              {"initial_amplitude", amplitude0},
@@ -542,6 +604,53 @@ struct Runner : CaseContext {
               "−0.16 %, peaks 0.99–1.06×). Reference (Basilisk, viscous La = 3000 against Prosperetti): RMS "
               "error 0.139, 0.0243, 0.0069, 0.0024 at 8, 16, 32, 64 points per wavelength. Plot: "
               "b4_wave.png.\n\n";
+        md << implicit_markdown(implicit_runs, "cells_per_wavelength",
+                                {{"ω (1/s)", "omega", "%.5g"}, {"γ (1/s)", "decay_rate", "%.3g"}});
+    }
+
+    /// A column of implicit_markdown(): heading, results.json key, printf format.
+    struct Column {
+        const char* heading;
+        const char* key;
+        const char* format;
+    };
+    /// The comparison pair of a case (variants_of()): the explicit run at the solver's own Δt
+    /// first, then the semi-implicit one, each quantity with its difference from the explicit.
+    static std::string implicit_markdown(const Json& comparison, const char* resolution_key,
+                                         const std::vector<Column>& columns) {
+        std::ostringstream md;
+        if (comparison.empty())
+            return "";
+        const Json& explicit_run = comparison[0];
+        md << "Semi-implicit surface tension (`/coupling/implicit_tension` 1, Hysing 2006) at "
+           << fmt(IMPLICIT_DT_FACTOR, "%.3g")
+           << "× the capillary limit, beside the explicit run at the solver's own Δt, both with "
+              "trilinear vertex velocities (`/coupling/velocity_interpolation` trilinear, which "
+              "the implicit tension needs; target: the same frequencies within 2 %):\n\n"
+              "| resolution | tension | Δt (s) | steps |";
+        for (const Column& c : columns)
+            md << " " << c.heading << " | vs explicit |";
+        md << " wall (s) |\n|---|---|---|---|";
+        for (size_t i = 0; i < columns.size(); ++i)
+            md << "---|---|";
+        md << "---|\n";
+        const auto row = [&](const Json& r, const char* what) {
+            md << "| " << r[resolution_key] << " | " << what << " "
+               << dt_factor_text(r["dt_factor"].get<double>()) << " | "
+               << fmt(r["dt"].get<double>(), "%.3g") << " | " << r["steps"] << " |";
+            for (const Column& c : columns) {
+                const double value = r[c.key].get<double>();
+                md << " " << fmt(value, c.format) << " | "
+                   << (&r == &explicit_run ? std::string("—")
+                                           : percent(value, explicit_run[c.key].get<double>()))
+                   << " |";
+            }
+            md << " " << fmt(r["wall_seconds"].get<double>(), "%.0f") << " |\n";
+        };
+        for (const Json& r : comparison)
+            row(r, r["implicit_tension"].get<bool>() ? "implicit" : "explicit");
+        md << "\n";
+        return md.str();
     }
 
 };

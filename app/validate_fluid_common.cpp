@@ -18,7 +18,9 @@ std::string percent(double measured, double reference) {
 }
 
 std::string dt_factor_text(double factor) {
-    return factor == 1.0 ? std::string("Δt") : "Δt/" + fmt(1.0 / factor, "%.3g");
+    if (factor == 1.0)
+        return "Δt";
+    return factor > 1.0 ? fmt(factor, "%.3g") + "Δt" : "Δt/" + fmt(1.0 / factor, "%.3g");
 }
 
 Json base_scene(const std::string& name) {

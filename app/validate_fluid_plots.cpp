@@ -198,14 +198,16 @@ if "B7" in b:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7)
     study_panel(bx, B7["speed"], "cells per diameter", 0.05)
-    blended = B7.get("speed_volume_fraction")
-    if blended and blended["rows"]:
-        bx.loglog([row["resolution"] for row in blended["rows"]],
-                  [max(abs(row["runs"][0]["relative_error"]) * 100, 1e-3)
-                   for row in blended["rows"]], "s--", ms=4,
-                  label="rise speed U, volume_fraction weights, own dt")
-        bx.legend(fontsize=7)
-    bx.set_title("B7 rise speed error (sharp weights unless marked)")
+    for key, marker, name in (("speed_sharp", "^--", "sharp"),
+                              ("speed_volume_fraction", "s--", "volume_fraction")):
+        other = B7.get(key)
+        if other and other["rows"]:
+            bx.loglog([row["resolution"] for row in other["rows"]],
+                      [max(abs(row["runs"][0]["relative_error"]) * 100, 1e-3)
+                       for row in other["rows"]], marker, ms=4,
+                      label="rise speed U, %s weights, own dt" % name)
+    bx.legend(fontsize=7)
+    bx.set_title("B7 rise speed error (pointwise weights unless marked)")
     save(fig, "b7_creeping_bubble.png")
 )PY";
 

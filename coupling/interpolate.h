@@ -8,6 +8,8 @@
 #include "fluid/mac_grid.h"
 #include "tracker/mesh.h"
 
+#include <Eigen/SparseCore>
+
 #include <vector>
 
 namespace meniscus::coupling {
@@ -82,5 +84,14 @@ std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& g
                                                          const tracker::SurfaceMesh& mesh,
                                                          const InterpolateOptions& options = {},
                                                          const fluid::WallOptions& walls = {});
+
+/// The weights behind interpolate_vertex_velocities(): row 3p + a holds the weights of the face
+/// velocities whose sum is component a of the velocity of vertex `vertices[p]` — the same method,
+/// normals and mirroring, so S u reproduces the vertex velocities of any grid `u`. Columns index
+/// the flat face vector [u | v | w] (offset_a + MacGrid::velocity(a).index(i, j, k)). Throws
+/// std::invalid_argument on invalid options or a vertex that is not live.
+Eigen::SparseMatrix<double, Eigen::RowMajor> vertex_velocity_weights(
+    const fluid::MacGrid& grid, const tracker::SurfaceMesh& mesh, const std::vector<int>& vertices,
+    const InterpolateOptions& options = {}, const fluid::WallOptions& walls = {});
 
 }  // namespace meniscus::coupling

@@ -1,11 +1,13 @@
 #include "coupling/simulation.h"
 
+#include "coupling/implicit_tension.h"
 #include "tracker/mesh_measures.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 namespace meniscus::coupling {
 
@@ -21,8 +23,19 @@ void SimulationOptions::validate() const {
     rasterize.validate();
     surface_tension.validate();
     interpolate.validate();
-    if (!(capillary_safety > 0.0 && capillary_safety <= 1.0))
-        throw std::invalid_argument("capillary_safety: expected a number in (0, 1]");
+    if (!(implicit_tension >= 0.0 && implicit_tension <= 1.0))
+        throw std::invalid_argument("implicit_tension: expected a number in [0, 1]");
+    if (implicit_tension > 0.0 && interpolate.method != VelocityInterpolation::trilinear)
+        throw std::invalid_argument(
+            "implicit_tension: needs the trilinear vertex velocities (velocity_interpolation "
+            "trilinear)");
+    if (implicit_tension == 0.0 && !(capillary_safety > 0.0 && capillary_safety <= 1.0))
+        throw std::invalid_argument(
+            "capillary_safety: expected a number in (0, 1] with explicit surface tension "
+            "(above 1 needs implicit_tension > 0)");
+    if (!(capillary_safety > 0.0 && capillary_safety <= MAX_IMPLICIT_CAPILLARY_SAFETY))
+        throw std::invalid_argument("capillary_safety: expected a number in (0, " +
+                                    std::to_string(MAX_IMPLICIT_CAPILLARY_SAFETY) + "]");
 }
 
 const char* to_string(StepLimit limit) {
@@ -90,6 +103,10 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     fluid::InterfaceInput interface;
     face_curvatures(mesh, grid, raster, m_options.surface_tension, interface);
     interface.phi = std::move(raster.phi);
+    if (m_options.implicit_tension > 0.0 && phases.sigma > 0.0)
+        interface.surface_viscosity = build_surface_viscosity(
+            mesh, grid, m_options.implicit_tension * phases.sigma * report.dt,
+            m_options.interpolate, m_fluid.options().walls);
     clock.lap_into(timings.curvature);
 
     // (3) Fluid.

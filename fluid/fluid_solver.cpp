@@ -1,5 +1,7 @@
 #include "fluid/fluid_solver.h"
 
+#include "fluid/surface_viscosity.h"
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -119,9 +121,12 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
     const PhaseOptions& phases = m_options.phases;
     const FluidMode mode = m_options.mode;
     const ViscousPressureOptions& scheme = m_options.viscous_pressure;
-    const bool viscous = m_options.viscosity.enabled &&
-                         (phases.mu_liquid > 0.0 ||
-                          (mode == FluidMode::two_phase && phases.mu_gas > 0.0));
+    const SurfaceViscosity* surface = interface.surface_viscosity.get();
+    const bool implicit_tension = surface && surface->viscosity > 0.0 && surface->points() > 0;
+    const bool viscous = (m_options.viscosity.enabled &&
+                          (phases.mu_liquid > 0.0 ||
+                           (mode == FluidMode::two_phase && phases.mu_gas > 0.0))) ||
+                         implicit_tension;
     // Without viscosity the projection alone already is the coupled step.
     const int max_iterations =
         scheme.coupling == ViscousPressureCoupling::coupled && viscous ? scheme.max_passes : 0;
@@ -178,7 +183,16 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
         double nu = phases.mu_liquid / phases.rho_liquid;
         if (mode == FluidMode::two_phase)
             nu = std::max(nu, phases.mu_gas / phases.rho_gas);
-        const double diffusion = nu * dt / (dx * dx);
+        if (!m_options.viscosity.enabled)
+            nu = 0.0;
+        double diffusion = nu * dt / (dx * dx);
+        if (implicit_tension) {
+            // The surface viscosity μ_s spread over a cell, a bulk μ_s/Δx, at the mean density.
+            const double rho_mean = mode == FluidMode::two_phase
+                                        ? 0.5 * (phases.rho_liquid + phases.rho_gas)
+                                        : phases.rho_liquid;
+            diffusion = std::max(diffusion, surface->viscosity * dt / (rho_mean * dx * dx * dx));
+        }
         const double viscous_share = diffusion / (1.0 + diffusion);
         const auto divergence_ratio = [&]() {
             double largest = 0.0;

@@ -1,5 +1,7 @@
 #include "fluid/interface_input.h"
 
+#include "fluid/surface_viscosity.h"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -43,6 +45,8 @@ void InterfaceInput::validate(const MacGrid& grid) const {
             throw std::invalid_argument("InterfaceInput.phi holds a non-finite value");
         }
     }
+    if (surface_viscosity)
+        surface_viscosity->validate(grid);
 }
 
 double liquid_fraction(double phi_a, double phi_b) {

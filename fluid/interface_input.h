@@ -5,7 +5,11 @@
 #include "fluid/array3.h"
 #include "fluid/mac_grid.h"
 
+#include <memory>
+
 namespace meniscus::fluid {
+
+struct SurfaceViscosity;
 
 /// Interface description for one fluid step.
 ///
@@ -16,11 +20,14 @@ namespace meniscus::fluid {
 ///   R), POSITIVE FOR A CONVEX LIQUID BLOB (a drop) and negative around a gas bubble. Only read on
 ///   faces whose two adjacent cells have φ of opposite sign; other entries are ignored.
 /// - The pressure jump imposed on such a face is p_liquid − p_gas = σκ (higher inside a drop).
+/// - `surface_viscosity` (optional): the implicit part of semi-implicit surface tension, which
+///   the viscous solve adds (surface_viscosity.h); null for explicit surface tension.
 struct InterfaceInput {
     Array3<double> phi;      ///< level set at cell centres, m, negative in the liquid
     Array3<double> kappa_u;  ///< κ on x-faces, 1/m, (nx+1) × ny × nz
     Array3<double> kappa_v;  ///< κ on y-faces, 1/m, nx × (ny+1) × nz
     Array3<double> kappa_w;  ///< κ on z-faces, 1/m, nx × ny × (nz+1)
+    std::shared_ptr<const SurfaceViscosity> surface_viscosity;  ///< null: none
 
     InterfaceInput() = default;
     /// Arrays sized for `grid`: φ = −dx everywhere (all liquid), κ = 0.

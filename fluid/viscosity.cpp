@@ -1,5 +1,7 @@
 #include "fluid/viscosity.h"
 
+#include "fluid/surface_viscosity.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -36,10 +38,13 @@ public:
     /// (Re)builds the operator for a grid, interface and time step, reusing the arrays' memory.
     void build(const MacGrid& grid, const Array3<double>& phi, const PhaseOptions& phases,
                FluidMode mode, const WallOptions& walls, double dt, double min_liquid_fraction,
-               ViscosityWeights weights) {
+               ViscosityWeights weights, const SurfaceViscosity* surface) {
         m_n = {grid.nx(), grid.ny(), grid.nz()};
         m_dx = grid.dx();
         m_dt = dt;
+        m_surface = surface;
+        // The surface term's energy ½ Δt μ_s (S u)ᵀ L (S u), per cell volume as the rest.
+        m_surface_scale = surface ? dt * surface->viscosity / (m_dx * m_dx * m_dx) : 0.0;
         std::size_t offset = 0;
         for (int a = 0; a < 3; ++a) {
             m_face_dims[a] = m_n;
@@ -56,6 +61,7 @@ public:
         m_mu.resize(m_n[0], m_n[1], m_n[2]);
         m_fraction_weights = mode == FluidMode::free_surface ||
                              weights == ViscosityWeights::volume_fraction;
+        m_pointwise_edges = mode == FluidMode::two_phase && weights == ViscosityWeights::pointwise;
         m_mu_gas = mode == FluidMode::two_phase ? phases.mu_gas : 0.0;
         for (std::size_t c = 0; c < m_mu.size(); ++c) {
             m_mu[c] = m_fraction_weights
@@ -93,6 +99,8 @@ public:
         normal_stresses(x);
         shear_stresses(x);
         stress_divergence(y);
+        if (m_surface)
+            m_surface->add_stiffness(m_surface_scale, x, y);
     }
 
     /// y = (ρ + K) x restricted to the unknowns (x must vanish on fixed faces; y does too).
@@ -132,6 +140,13 @@ public:
                 }
                 d[flat] = sum;
             });
+        }
+        if (m_surface) {
+            std::vector<double> surface(m_size, 0.0);
+            m_surface->add_diagonal_bound(m_surface_scale, surface);
+            for (std::size_t f = 0; f < m_size; ++f)
+                if (m_unknown[f])
+                    d[f] += surface[f];
         }
     }
 
@@ -242,21 +257,25 @@ private:
                         if (free_slip) {
                             continue;  // zero shear stress on a free-slip wall
                         }
-                        if (m_fraction_weights) {
+                        if (m_fraction_weights || m_pointwise_edges) {
                             // Batty & Bridson 2008: the shear term weighted by the liquid
                             // fraction of the edge's control volume (φ at the edge: the mean of
                             // its cells), so a traction-free surface sits where φ = 0, not on
-                            // the cell faces next to the void.
+                            // the cell faces next to the void. Pointwise: the μ of the phase
+                            // at the edge's midpoint, by the sign of the same φ.
                             double phi_sum = 0.0;
                             int count = 0;
                             for_each_edge_cell(e, a, b, [&](const Index3& cell) {
                                 phi_sum += phi(cell[0], cell[1], cell[2]);
                                 ++count;
                             });
+                            const double phi_edge = phi_sum / count;
                             weight(i, j, k) =
                                 SHEAR_WEIGHT * fraction *
-                                blended_mu(phases.mu_liquid,
-                                           control_volume_fraction(phi_sum / count));
+                                (m_pointwise_edges
+                                     ? (is_liquid(phi_edge) ? phases.mu_liquid : m_mu_gas)
+                                     : blended_mu(phases.mu_liquid,
+                                                  control_volume_fraction(phi_edge)));
                             continue;
                         }
                         // Harmonic mean of the (up to 4) cells around the edge: exact for the
@@ -441,6 +460,9 @@ private:
     std::size_t m_size = 0;
     Array3<double> m_mu;                          ///< μ per cell
     bool m_fraction_weights = false;              ///< μ blended by control-volume fractions
+    bool m_pointwise_edges = false;               ///< μ_e of the phase at the edge's midpoint
+    const SurfaceViscosity* m_surface = nullptr;  ///< the implicit tension term, if any
+    double m_surface_scale = 0.0;                 ///< Δt μ_s / Δx³
     double m_mu_gas = 0.0;                        ///< 0 in free_surface mode
     std::array<Array3<double>, 3> m_edge_weight;  ///< W_e per edge, by the axis it is parallel to
     std::vector<char> m_unknown;                  ///< 1 on faces that are solved for
@@ -453,7 +475,8 @@ private:
 
 void ViscosityOptions::validate() const {
     iteration.validate();
-    if (weights != ViscosityWeights::sharp && weights != ViscosityWeights::volume_fraction)
+    if (weights != ViscosityWeights::sharp && weights != ViscosityWeights::volume_fraction &&
+        weights != ViscosityWeights::pointwise)
         throw std::invalid_argument("ViscosityOptions.weights: unknown weighting");
     if (preconditioner != ViscousPreconditioner::jacobi &&
         preconditioner != ViscousPreconditioner::multigrid)
@@ -470,6 +493,9 @@ struct OperatorKey {
     FluidMode mode = FluidMode::two_phase;
     std::array<WallType, 6> walls{};
     ViscosityWeights weights = ViscosityWeights::sharp;
+    /// The surface term, compared by address: held here, so a new one (the caller builds one
+    /// for each step) cannot take the old one's address.
+    std::shared_ptr<const SurfaceViscosity> surface;
     std::vector<double> phi;
 
     OperatorKey() = default;
@@ -494,7 +520,8 @@ struct OperatorKey {
         return cells == o.cells && dx == o.dx && dt == o.dt &&
                min_liquid_fraction == o.min_liquid_fraction && rho_liquid == o.rho_liquid &&
                rho_gas == o.rho_gas && mu_liquid == o.mu_liquid && mu_gas == o.mu_gas &&
-               mode == o.mode && walls == o.walls && weights == o.weights;
+               mode == o.mode && walls == o.walls && weights == o.weights &&
+               surface == o.surface;
     }
 };
 
@@ -526,14 +553,22 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         throw std::invalid_argument("apply_viscosity: dt must be positive (s)");
     }
     SolveResult result;
-    const double mu_gas = mode == FluidMode::two_phase ? phases.mu_gas : 0.0;
-    if (!options.enabled || (phases.mu_liquid == 0.0 && mu_gas == 0.0)) {
+    std::shared_ptr<const SurfaceViscosity> surface = interface.surface_viscosity;
+    if (surface && (surface->viscosity == 0.0 || surface->points() == 0))
+        surface.reset();
+    // Viscosity switched off leaves the surface term alone to solve for.
+    PhaseOptions viscous_phases = phases;
+    if (!options.enabled)
+        viscous_phases.mu_liquid = viscous_phases.mu_gas = 0.0;
+    const double mu_gas = mode == FluidMode::two_phase ? viscous_phases.mu_gas : 0.0;
+    if (!surface && (viscous_phases.mu_liquid == 0.0 && mu_gas == 0.0)) {
         result.converged = true;
         return result;
     }
     Workspace& ws = *m_workspace;
     ViscousOperator& op = ws.op;
-    OperatorKey key(grid, phases, mode, walls, dt, min_liquid_fraction, options.weights);
+    OperatorKey key(grid, viscous_phases, mode, walls, dt, min_liquid_fraction, options.weights);
+    key.surface = surface;
     const bool reuse = !ws.key.phi.empty() && ws.key.same_settings(key) &&
                        ws.key.phi == interface.phi.storage();
     if (!reuse) {
@@ -541,8 +576,8 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         ws.diagonal.clear();
         for (auto& cycle : ws.cycles)
             cycle.reset();
-        op.build(grid, interface.phi, phases, mode, walls, dt, min_liquid_fraction,
-                 options.weights);
+        op.build(grid, interface.phi, viscous_phases, mode, walls, dt, min_liquid_fraction,
+                 options.weights, surface.get());
         key.phi = interface.phi.storage();
         ws.key = std::move(key);
     }

@@ -197,6 +197,32 @@ TEST(Scene, ErrorsNameTheJsonPath) {
     EXPECT_NE(error_of("[1, 2]").find("/: expected an object"), std::string::npos);
 }
 
+/// Semi-implicit surface tension: past the capillary limit only with it, and only with the
+/// trilinear vertex velocities it is stable with; each refusal names the field.
+TEST(Scene, ImplicitTensionAndTheCapillaryLimitAreCheckedTogether) {
+    const std::string fluid =
+        R"("flow": {"type": "fluid"}, "surface": {"shape": {"type": "sphere"}}, )";
+    EXPECT_NE(error_of("{" + fluid + R"("coupling": {"capillary_safety": 3}})")
+                  .find("/coupling/capillary_safety: above 1 the explicit surface tension is "
+                        "unstable"),
+              std::string::npos);
+    EXPECT_NE(error_of("{" + fluid + R"("coupling": {"capillary_safety": 3, "implicit_tension": 1}})")
+                  .find("/coupling/implicit_tension: needs /coupling/velocity_interpolation"),
+              std::string::npos);
+    EXPECT_NE(error_of("{" + fluid + R"("coupling": {"implicit_tension": 1.5}})")
+                  .find("/coupling/implicit_tension: expected a number in [0, 1]"),
+              std::string::npos);
+    EXPECT_NE(error_of("{" + fluid + R"("coupling": {"capillary_safety": 25, "implicit_tension": 1, "velocity_interpolation": "trilinear"}})")
+                  .find("/coupling/capillary_safety: expected a number in (0, 20]"),
+              std::string::npos);
+    const Scene scene = parse_scene(
+        "{" + fluid +
+            R"("coupling": {"capillary_safety": 3, "implicit_tension": 1, "velocity_interpolation": "trilinear"}})",
+        "test.json", ".");
+    EXPECT_EQ(scene.coupling.simulation.implicit_tension, 1.0);
+    EXPECT_EQ(scene.coupling.simulation.capillary_safety, 3.0);
+}
+
 TEST(Scene, OutputKeys) {
     const char* sphere = R"("surface": {"shape": {"type": "sphere"}})";
     const Scene defaults = parse_scene(std::string("{") + sphere + "}", "test.json", ".");

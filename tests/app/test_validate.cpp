@@ -16,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -111,11 +112,13 @@ constexpr double B6_QUICK_DAMPING_RELATIVE = 0.08;
 /// The coupled step's answer does not move with Δt (the split step's would, by the viscous
 /// diffusion number): own Δt against Δt/2.
 constexpr double B6_DT_CHANGE_RELATIVE = 0.01;
-/// B7 creeping bubble at 8 cells per diameter in a 6-radius free-slip box: measured +18.9 %
-/// against the wall-corrected Hadamard–Rybczynski speed (the spatial error at 8 cells per
-/// diameter; the split step gave +480 % at the same Δt, diffusion number 11).
-constexpr double B7_QUICK_SPEED_RELATIVE = 0.25;
-/// The same with /fluid/viscosity_weights volume_fraction: measured −8.5 %.
+/// B7 creeping bubble at 8 cells per diameter in a 6-radius free-slip box against the
+/// wall-corrected Hadamard–Rybczynski speed, /fluid/viscosity_weights pointwise (the default):
+/// measured +1.3 % (the split step gave +480 % at the same Δt, diffusion number 11).
+constexpr double B7_QUICK_SPEED_RELATIVE = 0.04;
+/// The same with the sharp weights (harmonic mean on edges): +17.4 %; with volume_fraction:
+/// −8.5 %. Both are biased by about half a cell, to either side.
+constexpr double B7_QUICK_SHARP_RELATIVE = 0.25;
 constexpr double B7_QUICK_BLENDED_RELATIVE = 0.12;
 constexpr double B7_DT_CHANGE_RELATIVE = 0.02;
 /// Steady by the end: the last quarter's mean speed against the quarter before.
@@ -388,6 +391,36 @@ TEST_F(QuickValidation, PartBCasesCarryConvergenceStudies) {
     }
 }
 
+/// Semi-implicit surface tension at 3× the capillary limit against the explicit run, both with
+/// trilinear vertex velocities (issue 36 item 3): measured B4 ω −0.59 % (and its extra damping
+/// about ω²Δt/2: γ 0.79 against 0.06 1/s), B1 Δp −0.003 % with the peak spurious currents 5.3×
+/// the explicit run's (3.4e-2 against 6.3e-3 in max|u|·sqrt(ρD/σ)).
+TEST_F(QuickValidation, PartBImplicitTensionKeepsTheFrequencyAtThreeTimesTheCapillaryStep) {
+    const Json& b = s_results["part_b"];
+    for (const char* id : {"B1", "B4"}) {
+        SCOPED_TRACE(id);
+        const Json& pair = b[id]["implicit_runs"];
+        ASSERT_EQ(pair.size(), 2u);
+        EXPECT_FALSE(pair[0]["implicit_tension"].get<bool>());
+        EXPECT_TRUE(pair[1]["implicit_tension"].get<bool>());
+        EXPECT_NEAR(pair[1]["dt"].get<double>(), 3.0 * pair[0]["dt"].get<double>(),
+                    0.05 * pair[1]["dt"].get<double>());
+        EXPECT_LT(pair[1]["steps"].get<long long>(), pair[0]["steps"].get<long long>() / 2);
+        for (const Json& r : pair) {
+            EXPECT_TRUE(r["completed"].get<bool>());
+            EXPECT_EQ(r["max_intersecting_pairs"].get<int>(), 0);
+        }
+    }
+    const Json& wave = b["B4"]["implicit_runs"];
+    EXPECT_LT(std::abs(wave[1]["omega"].get<double>() / wave[0]["omega"].get<double>() - 1.0),
+              0.02);
+    const Json& drop = b["B1"]["implicit_runs"];
+    EXPECT_LT(std::abs(drop[1]["jump"].get<double>() / drop[0]["jump"].get<double>() - 1.0), 1e-3);
+    EXPECT_LT(drop[1]["capillary_number_peak"].get<double>(), B1_SPURIOUS_CAPILLARY_NUMBER);
+    EXPECT_TRUE(b["B2"]["implicit_runs"].empty());  // full mode only
+    EXPECT_NE(s_report.find("Semi-implicit surface tension"), std::string::npos);
+}
+
 TEST_F(QuickValidation, PartBOscillationsAndGrowthAgainstTheory) {
     const Json& b = s_results["part_b"];
     ASSERT_EQ(b["B2"]["runs"].size(), 1u);
@@ -457,32 +490,41 @@ TEST_F(QuickValidation, PartBViscousDropHasTheExactModeAtEveryTimeStep) {
 
 TEST_F(QuickValidation, PartBCreepingBubbleRisesAtTheReferenceSpeedAtItsOwnTimeStep) {
     const Json& b7 = s_results["part_b"]["B7"];
-    Json runs = Json::array(), blended = Json::array();
-    for (const Json& r : b7["runs"])
-        (r["weights"] == "sharp" ? runs : blended).push_back(r);
-    ASSERT_EQ(runs.size(), 2u);     // own Δt and Δt/2
-    ASSERT_EQ(blended.size(), 1u);  // volume_fraction weights at the own Δt
+    std::map<std::string, Json> by_weights;
     for (const Json& r : b7["runs"]) {
-        SCOPED_TRACE("dt factor " + r["dt_factor"].dump());
+        Json& list = by_weights[r["weights"].get<std::string>()];
+        if (list.is_null())
+            list = Json::array();
+        list.push_back(r);
+    }
+    ASSERT_EQ(by_weights["pointwise"].size(), 2u);  // own Δt and Δt/2
+    ASSERT_EQ(by_weights["sharp"].size(), 1u);      // own Δt
+    ASSERT_EQ(by_weights["volume_fraction"].size(), 1u);
+    const auto error = [](const Json& r) {
+        return r["rise_speed"].get<double>() / r["reference_speed"].get<double>() - 1.0;
+    };
+    for (const Json& r : b7["runs"]) {
+        SCOPED_TRACE(r["weights"].get<std::string>() + ", dt factor " + r["dt_factor"].dump());
         EXPECT_TRUE(r["completed"].get<bool>());
         EXPECT_EQ(r["max_intersecting_pairs"].get<int>(), 0);
-        const double u = r["rise_speed"].get<double>();
-        EXPECT_LT(std::abs(u / r["reference_speed"].get<double>() - 1.0), B7_QUICK_SPEED_RELATIVE);
-        EXPECT_LT(std::abs(r["rise_speed_previous_quarter"].get<double>() / u - 1.0),
+        EXPECT_LT(std::abs(error(r)), B7_QUICK_SHARP_RELATIVE);
+        EXPECT_LT(std::abs(r["rise_speed_previous_quarter"].get<double>() /
+                               r["rise_speed"].get<double>() -
+                           1.0),
                   B7_STEADY_RELATIVE);
     }
+    const Json& runs = by_weights["pointwise"];
+    for (const Json& r : runs)
+        EXPECT_LT(std::abs(error(r)), B7_QUICK_SPEED_RELATIVE);
     // The solver's own Δt is at viscous diffusion number ≈ 11 in the liquid.
     EXPECT_GT(runs[0]["diffusion_number"].get<double>(), 5.0);
     EXPECT_LT(std::abs(runs[1]["rise_speed"].get<double>() / runs[0]["rise_speed"].get<double>() -
                        1.0),
               B7_DT_CHANGE_RELATIVE);
-    // The blended weights: −8.5 % against the sharp weights' +17.4 % (measured).
-    const double blended_error =
-        blended[0]["rise_speed"].get<double>() / blended[0]["reference_speed"].get<double>() - 1.0;
-    const double sharp_error =
-        runs[0]["rise_speed"].get<double>() / runs[0]["reference_speed"].get<double>() - 1.0;
-    EXPECT_LT(std::abs(blended_error), B7_QUICK_BLENDED_RELATIVE);
-    EXPECT_LT(std::abs(blended_error), std::abs(sharp_error));
+    // The harmonic edge mean makes the bubble too fast, the blended weights too slow.
+    EXPECT_GT(error(by_weights["sharp"][0]), 0.1);
+    EXPECT_LT(error(by_weights["volume_fraction"][0]), -0.04);
+    EXPECT_LT(std::abs(error(by_weights["volume_fraction"][0])), B7_QUICK_BLENDED_RELATIVE);
     EXPECT_NE(s_report.find("## B7"), std::string::npos);
     EXPECT_NE(s_report.find("With `volume_fraction`"), std::string::npos);
     EXPECT_TRUE(fs::exists(s_out / "b7_creeping_bubble.png"));

@@ -235,6 +235,65 @@ TEST(Interpolate, MirrorReflectsTheFlowAcrossFreeSlipWallsAndClampsAtNoSlipOnes)
     EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
+/// The weights (semi-implicit tension's S) reproduce the vertex velocities of any grid velocity
+/// for every method, with vertices inside the box and beyond free-slip and no-slip walls.
+TEST(Interpolate, VertexVelocityWeightsReproduceTheInterpolatedVelocities) {
+    fluid::MacGrid grid(10, 8, 9, 0.1);  // [0, 1] × [0, 0.8] × [0, 0.9]
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> value(-1.0, 1.0);
+    for (int axis = 0; axis < 3; ++axis)
+        for (double& u : grid.velocity(axis).storage())
+            u = value(rng);
+    fluid::WallOptions walls;
+    walls.x_max = fluid::WallType::no_slip;
+    tracker::ImplicitMeshOptions mesher;
+    mesher.edge_length = 0.08;
+    tracker::SurfaceMesh mesh = tracker::mesh_implicit_shape(
+        *tracker::make_sphere(Vector3d(0.5, 0.4, 0.45), 0.3), mesher);
+    // Three more vertices beyond the walls (x_min free-slip, z_max free-slip, x_max no-slip).
+    const int a = mesh.add_vertex(Vector3d(-0.2, 0.4, 0.45));
+    const int b = mesh.add_vertex(Vector3d(0.5, 0.4, 1.1));
+    const int c = mesh.add_vertex(Vector3d(1.25, 0.9, 0.45));
+    mesh.add_triangle({a, b, c});
+    std::vector<int> vertices;
+    for (int v = 0; v < mesh.num_vertices(); ++v)
+        if (mesh.vertex_alive(v))
+            vertices.push_back(v);
+    std::vector<double> faces;
+    for (int axis = 0; axis < 3; ++axis)
+        faces.insert(faces.end(), grid.velocity(axis).storage().begin(),
+                     grid.velocity(axis).storage().end());
+    const Eigen::Map<const Eigen::VectorXd> u(faces.data(), static_cast<Eigen::Index>(faces.size()));
+    for (VelocityInterpolation method :
+         {VelocityInterpolation::trilinear, VelocityInterpolation::quadratic_bspline,
+          VelocityInterpolation::one_sided}) {
+        for (OutsideVelocity outside : {OutsideVelocity::clamp, OutsideVelocity::mirror}) {
+            InterpolateOptions options;
+            options.method = method;
+            options.outside = outside;
+            const std::vector<tracker::Vec3> velocity =
+                interpolate_vertex_velocities(grid, mesh, options, walls);
+            const Eigen::SparseMatrix<double, Eigen::RowMajor> weights =
+                vertex_velocity_weights(grid, mesh, vertices, options, walls);
+            ASSERT_EQ(weights.rows(), static_cast<Eigen::Index>(3 * vertices.size()));
+            ASSERT_EQ(weights.cols(), static_cast<Eigen::Index>(faces.size()));
+            const Eigen::VectorXd sampled = weights * u;
+            double max_error = 0.0;
+            for (size_t p = 0; p < vertices.size(); ++p)
+                for (int d = 0; d < 3; ++d)
+                    max_error = std::max(
+                        max_error,
+                        std::abs(sampled[static_cast<Eigen::Index>(3 * p + d)] -
+                                 velocity[static_cast<size_t>(vertices[p])][d]));
+            EXPECT_LT(max_error, 1e-12) << "method " << static_cast<int>(method) << ", outside "
+                                        << static_cast<int>(outside);
+        }
+    }
+    const int dead = mesh.add_vertex(Vector3d::Constant(0.5));
+    mesh.remove_vertex(dead);
+    EXPECT_THROW(vertex_velocity_weights(grid, mesh, {dead}), std::invalid_argument);
+}
+
 TEST(Interpolate, QuadraticBSplineIsSmootherThanTrilinear) {
     // A velocity that alternates sign face by face (the grid's highest frequency): trilinear
     // passes it on at full amplitude at the faces, the B-spline damps it (to ½ at a face).

@@ -1,0 +1,54 @@
+#include "fluid/surface_viscosity.h"
+
+#include "fluid/mac_grid.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace meniscus::fluid {
+
+void SurfaceViscosity::validate(const MacGrid& grid) const {
+    const std::ptrdiff_t faces = static_cast<std::ptrdiff_t>(
+        grid.u().size() + grid.v().size() + grid.w().size());
+    if (laplacian.rows() != laplacian.cols())
+        throw std::invalid_argument("SurfaceViscosity.laplacian must be square");
+    if (sample.rows() != 3 * laplacian.rows())
+        throw std::invalid_argument("SurfaceViscosity.sample must have 3 rows per surface point (" +
+                                    std::to_string(3 * laplacian.rows()) + ")");
+    if (sample.cols() != faces)
+        throw std::invalid_argument("SurfaceViscosity.sample must have one column per face (" +
+                                    std::to_string(faces) + ")");
+    if (!(viscosity >= 0.0) || !std::isfinite(viscosity))
+        throw std::invalid_argument("SurfaceViscosity.viscosity must be a finite number >= 0");
+}
+
+void SurfaceViscosity::add_stiffness(double c, const std::vector<double>& x,
+                                     std::vector<double>& y) const {
+    const std::ptrdiff_t p = points();
+    if (p == 0 || c == 0.0)
+        return;
+    const Eigen::Map<const Eigen::VectorXd> xv(x.data(), static_cast<Eigen::Index>(x.size()));
+    // s = S x as a P × 3 matrix (row p: the velocity at point p), t = L s column by column.
+    const Eigen::VectorXd s = sample * xv;
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> sp(
+        s.data(), p, 3);
+    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> t = laplacian * sp;
+    const Eigen::Map<const Eigen::VectorXd> tv(t.data(), 3 * p);
+    Eigen::Map<Eigen::VectorXd> yv(y.data(), static_cast<Eigen::Index>(y.size()));
+    yv += c * (sample.transpose() * tv);
+}
+
+void SurfaceViscosity::add_diagonal_bound(double c, std::vector<double>& d) const {
+    if (points() == 0 || c == 0.0)
+        return;
+    const Eigen::VectorXd diagonal = laplacian.diagonal();
+    for (Eigen::Index row = 0; row < sample.outerSize(); ++row) {
+        const double l = diagonal[row / 3];
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(sample, row); it;
+             ++it)
+            d[static_cast<std::size_t>(it.col())] += c * l * it.value() * it.value();
+    }
+}
+
+}  // namespace meniscus::fluid
