@@ -122,7 +122,7 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
     const FluidMode mode = m_options.mode;
     const ViscousPressureOptions& scheme = m_options.viscous_pressure;
     const SurfaceViscosity* surface = interface.surface_viscosity.get();
-    const bool implicit_tension = surface && surface->viscosity > 0.0 && surface->points() > 0;
+    const bool implicit_tension = surface && surface->active();
     const bool viscous = (m_options.viscosity.enabled &&
                           (phases.mu_liquid > 0.0 ||
                            (mode == FluidMode::two_phase && phases.mu_gas > 0.0))) ||

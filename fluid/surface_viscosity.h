@@ -41,6 +41,8 @@ struct SurfaceViscosity {
 
     /// P, the number of surface points.
     std::ptrdiff_t points() const { return laplacian.rows(); }
+    /// Whether the term acts at all: a positive viscosity on at least one point.
+    bool active() const { return viscosity > 0.0 && points() > 0; }
 
     /// Throws std::invalid_argument naming the field when the sizes do not fit `grid` or each
     /// other, or the viscosity is negative or not finite.

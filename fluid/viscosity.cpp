@@ -554,7 +554,7 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     }
     SolveResult result;
     std::shared_ptr<const SurfaceViscosity> surface = interface.surface_viscosity;
-    if (surface && (surface->viscosity == 0.0 || surface->points() == 0))
+    if (surface && !surface->active())
         surface.reset();
     // Viscosity switched off leaves the surface term alone to solve for.
     PhaseOptions viscous_phases = phases;
