@@ -119,6 +119,7 @@ int main(int argc, char** argv) {
     double smooth = 0, split = 0, flip = 0, collapse = 0;
     double merge = 0, separate = 0, compact = 0, quiet_topology = 0;
     long quiet_steps = 0;  // steps whose topology phase changed nothing
+    long candidate_steps = 0, candidates = 0;  // steps with merge candidates, and how many
     int min_tris = mesh.count_live_triangles(), max_tris = min_tris;
     double t = 0.0;
     long steps = 0;
@@ -138,6 +139,8 @@ int main(int argc, char** argv) {
         const TopologyReport tr = tracker.change_topology();
         topology.stop();
         merge += tr.merge.seconds;
+        candidates += tr.merge.candidates;
+        candidate_steps += tr.merge.candidates > 0 ? 1 : 0;
         separate += tr.separation.seconds;
         compact += (topology.wall - topology_wall) - tr.seconds;
         if (tr.merge.merges == 0 && tr.separation.singular_vertices_split == 0 &&
@@ -179,6 +182,7 @@ int main(int argc, char** argv) {
     std::printf("topology parts, wall per step (s): merge %.4f  separate %.4f  compact "
                 "%.4f; on the %ld steps without a change %.4f\n",
                 merge / n, separate / n, compact / n, quiet_steps, quiet_topology / std::max(quiet_steps, 1L));
+    std::printf("merge candidates: %ld on %ld steps\n", candidates, candidate_steps);
     std::printf("wall %.2f s, process CPU %.2f s (%.2f s/step)\n", wall, cpu, cpu / n);
     std::printf("intersecting pairs at end: %zu\n", find_self_intersections(mesh).triangle_pairs.size());
     std::printf("final mesh hash: %016llx\n", static_cast<unsigned long long>(mesh_hash(mesh)));

@@ -37,6 +37,7 @@ SurfaceMesh::SurfaceMesh(std::vector<Vec3> positions, const std::vector<Triangle
                                     " triangles");
     m_positions = std::move(positions);
     m_vertex_alive.assign(m_positions.size(), 1);
+    m_vertex_marked.assign(m_positions.size(), 1);
     m_vertex_triangles.resize(m_positions.size());
     m_vertex_edges.resize(m_positions.size());
     m_triangles.reserve(triangles.size());
@@ -48,6 +49,8 @@ SurfaceMesh::SurfaceMesh(std::vector<Vec3> positions, const std::vector<Triangle
 SurfaceMesh::SurfaceMesh(const SurfaceMesh& other)
     : m_positions(other.m_positions),
       m_vertex_alive(other.m_vertex_alive),
+      m_vertex_marked(other.m_vertex_marked),
+      m_triangle_marked(other.m_triangle_marked),
       m_triangles(other.m_triangles),
       m_labels(other.m_labels),
       m_triangle_edges(other.m_triangle_edges),
@@ -157,6 +160,7 @@ int SurfaceMesh::other_vertex(int ei, int vi) const {
 int SurfaceMesh::add_vertex(const Vec3& p) {
     m_positions.push_back(p);
     m_vertex_alive.push_back(1);
+    m_vertex_marked.push_back(1);
     m_vertex_triangles.emplace_back();
     m_vertex_edges.emplace_back();
     const int vi = num_vertices() - 1;
@@ -194,6 +198,7 @@ void SurfaceMesh::attach_triangle(int ti) {
         tri_edges[k] = ei;
         m_edge_triangles[static_cast<size_t>(ei)].push_back(ti);
         m_vertex_triangles[static_cast<size_t>(t[k])].push_back(ti);
+        m_vertex_marked[static_cast<size_t>(t[k])] = 1;
     }
 }
 
@@ -202,6 +207,7 @@ void SurfaceMesh::detach_triangle(int ti) {
     const auto tri_edges = m_triangle_edges[static_cast<size_t>(ti)];
     for (int k = 0; k < 3; ++k) {
         erase_value(m_vertex_triangles[static_cast<size_t>(t[k])], ti);
+        m_vertex_marked[static_cast<size_t>(t[k])] = 1;
         auto& et = m_edge_triangles[static_cast<size_t>(tri_edges[k])];
         erase_value(et, ti);
         if (et.empty())
@@ -223,6 +229,7 @@ int SurfaceMesh::add_triangle(const Triangle& t, const LabelPair& labels) {
     m_triangles.push_back(t);
     m_labels.push_back(labels);
     m_triangle_edges.push_back({INVALID_INDEX, INVALID_INDEX, INVALID_INDEX});
+    m_triangle_marked.push_back(1);
     attach_triangle(ti);
     return ti;
 }
@@ -249,6 +256,7 @@ int SurfaceMesh::split_edge(int ei, const Vec3& position, double s) {
     const int m = num_vertices();
     m_positions.push_back(position);
     m_vertex_alive.push_back(1);
+    m_vertex_marked.push_back(1);
     m_vertex_triangles.emplace_back();
     m_vertex_edges.emplace_back();
     for (int ti : incident) {
@@ -321,6 +329,7 @@ int SurfaceMesh::duplicate_vertex(int vi, const std::vector<int>& triangles,
     const int copy = num_vertices();
     m_positions.push_back(copy_position);
     m_vertex_alive.push_back(1);
+    m_vertex_marked.push_back(1);
     m_vertex_triangles.emplace_back();
     m_vertex_edges.emplace_back();
     for (int ti : triangles) {
@@ -339,6 +348,10 @@ int SurfaceMesh::duplicate_vertex(int vi, const std::vector<int>& triangles,
     for (MeshObserver* o : m_observers)
         o->on_vertex_duplicated(vi, copy);
     return copy;
+}
+
+void SurfaceMesh::clear_triangle_marks() {
+    std::fill(m_triangle_marked.begin(), m_triangle_marked.end(), 0);
 }
 
 std::vector<int> SurfaceMesh::compact() {
@@ -381,6 +394,7 @@ std::vector<int> SurfaceMesh::compact() {
             continue;
         const size_t n = static_cast<size_t>(now);
         m_positions[n] = m_positions[vi];
+        m_vertex_marked[n] = m_vertex_marked[vi];
         if (n != vi) {
             m_vertex_triangles[n] = std::move(m_vertex_triangles[vi]);
             m_vertex_edges[n] = std::move(m_vertex_edges[vi]);
@@ -388,6 +402,7 @@ std::vector<int> SurfaceMesh::compact() {
     }
     m_positions.resize(static_cast<size_t>(nv));
     m_vertex_alive.assign(static_cast<size_t>(nv), 1);
+    m_vertex_marked.resize(static_cast<size_t>(nv));
     m_vertex_triangles.resize(static_cast<size_t>(nv));
     m_vertex_edges.resize(static_cast<size_t>(nv));
     tbb::parallel_for(0, nv, [&](int vi) {
@@ -408,10 +423,12 @@ std::vector<int> SurfaceMesh::compact() {
             m_triangle_edges[n][k] = edge_map[static_cast<size_t>(e[k])];
         }
         m_labels[n] = m_labels[ti];
+        m_triangle_marked[n] = m_triangle_marked[ti];
     }
     m_triangles.resize(static_cast<size_t>(nt));
     m_triangle_edges.resize(static_cast<size_t>(nt));
     m_labels.resize(static_cast<size_t>(nt));
+    m_triangle_marked.resize(static_cast<size_t>(nt));
 
     // Edges: new order is first appearance, not old order, so permute through scratch.
     std::vector<Edge> edges(static_cast<size_t>(ne));
@@ -524,6 +541,10 @@ void SurfaceMesh::load_state(BinaryReader& in) {
     check_index_lists(m.m_edge_triangles, static_cast<int>(nt), "an edge's triangle list");
     check_index_lists(m.m_vertex_triangles, static_cast<int>(nt), "a vertex's triangle list");
     check_index_lists(m.m_vertex_edges, static_cast<int>(ne), "a vertex's edge list");
+    // The marks are not saved: all set, separate() looks at everything once and finds what it
+    // would have found from the saved marks (they only skip what it would have left alone).
+    m.m_vertex_marked.assign(nv, 1);
+    m.m_triangle_marked.assign(nt, 1);
     m.m_observers = std::move(m_observers);
     *this = std::move(m);
 }

@@ -165,6 +165,18 @@ public:
     /// Returns the copy's index. Used to separate singular vertices.
     int duplicate_vertex(int vi, const std::vector<int>& triangles, const Vec3& copy_position);
 
+    // ---- connectivity marks (what separate() has to look at again) ----------------------
+    /// True if vertex vi was created, or a triangle was attached to it or detached from it,
+    /// since clear_vertex_mark(vi). Whether a vertex is one manifold fan depends on nothing
+    /// else, so an unmarked vertex found regular once is still regular. A mesh that is built
+    /// or loaded (load_state) starts with every mark set; a copy keeps the original's marks.
+    bool vertex_marked(int vi) const { return m_vertex_marked[static_cast<size_t>(vi)] != 0; }
+    void clear_vertex_mark(int vi) { m_vertex_marked[static_cast<size_t>(vi)] = 0; }
+    /// True if triangle ti was added since clear_triangle_marks() (every triangle of a mesh
+    /// that is built or loaded starts marked).
+    bool triangle_marked(int ti) const { return m_triangle_marked[static_cast<size_t>(ti)] != 0; }
+    void clear_triangle_marks();
+
     /// Removes dead slots and renumbers vertices, triangles and edges, preserving the order of
     /// live elements. Observers receive the vertex map. Returns the vertex map.
     std::vector<int> compact();
@@ -192,6 +204,8 @@ private:
 
     std::vector<Vec3> m_positions;
     std::vector<std::uint8_t> m_vertex_alive;
+    std::vector<std::uint8_t> m_vertex_marked;    // connectivity changed (see vertex_marked)
+    std::vector<std::uint8_t> m_triangle_marked;  // added since the marks were cleared
     std::vector<Triangle> m_triangles;  // dead: {-1, -1, -1}
     std::vector<LabelPair> m_labels;
     std::vector<std::array<int, 3>> m_triangle_edges;

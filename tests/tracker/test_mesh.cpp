@@ -209,6 +209,45 @@ TEST(SurfaceMesh, DuplicateVertexSeparatesFans) {
     EXPECT_TRUE(validate_mesh(m).empty());
 }
 
+TEST(SurfaceMesh, MarksFollowConnectivityChangesAndCompaction) {
+    // Built meshes start marked; a flip marks exactly the four vertices of its two triangles and
+    // the two new triangles; compaction carries the marks to the new indices.
+    SurfaceMesh m = octahedron();
+    for (int vi = 0; vi < m.num_vertices(); ++vi)
+        EXPECT_TRUE(m.vertex_marked(vi));
+    for (int ti = 0; ti < m.num_triangles(); ++ti)
+        EXPECT_TRUE(m.triangle_marked(ti));
+    for (int vi = 0; vi < m.num_vertices(); ++vi)
+        m.clear_vertex_mark(vi);
+    m.clear_triangle_marks();
+    const int ei = m.find_edge(0, 2);  // triangles (0, 2, 4) and (2, 0, 5)
+    ASSERT_NE(ei, INVALID_INDEX);
+    const std::vector<int> pair = m.edge_triangles(ei);
+    m.flip_edge(ei, pair[0], pair[1]);  // (0, 2) becomes (4, 5)
+    for (int vi = 0; vi < m.num_vertices(); ++vi)
+        EXPECT_EQ(m.vertex_marked(vi), vi == 0 || vi == 2 || vi == 4 || vi == 5) << vi;
+    for (int ti = 0; ti < m.num_triangles(); ++ti)
+        EXPECT_EQ(m.triangle_marked(ti), ti >= 8) << ti;
+    const SurfaceMesh copy = m;
+    EXPECT_TRUE(copy.vertex_marked(4) && !copy.vertex_marked(1));
+
+    const std::vector<int> vertex_map = m.compact();  // the two dead triangles go
+    ASSERT_EQ(m.num_triangles(), 8);
+    for (int vi = 0; vi < 6; ++vi)
+        EXPECT_EQ(m.vertex_marked(vertex_map[static_cast<size_t>(vi)]),
+                  vi == 0 || vi == 2 || vi == 4 || vi == 5);
+    for (int ti = 0; ti < m.num_triangles(); ++ti)
+        EXPECT_EQ(m.triangle_marked(ti), ti >= 6) << ti;  // the flip's two, last in order
+
+    // A duplicated vertex and its new triangles are marked.
+    m.clear_triangle_marks();
+    for (int vi = 0; vi < m.num_vertices(); ++vi)
+        m.clear_vertex_mark(vi);
+    const int copy_vi = m.duplicate_vertex(1, {m.vertex_triangles(1)[0]}, m.position(1));
+    EXPECT_TRUE(m.vertex_marked(copy_vi) && m.vertex_marked(1));
+    EXPECT_TRUE(m.triangle_marked(m.num_triangles() - 1));
+}
+
 TEST(MeshValidate, ListsEveryViolation) {
     // Open, inconsistently oriented, duplicated and degenerate, all at once.
     SurfaceMesh m({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {2, 0, 0}, {0, 0, 1}},

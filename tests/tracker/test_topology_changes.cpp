@@ -253,6 +253,45 @@ TEST(Separation, RemovesDegenerateTetrahedraAndSplitsSingularVertices) {
     EXPECT_EQ(flat.count_live_triangles(), 0);
 }
 
+TEST(Separation, LooksAgainAtWhatChangedSinceTheLastPass) {
+    // separate() only looks at the vertices and triangles that the mesh marked as changed since
+    // its last pass. Two disjoint tetrahedra, separated once (nothing to do, marks cleared); then
+    // tetrahedron B is rewired onto A's vertex 0 by add/remove_triangle alone, which must make
+    // vertex 0 a singular vertex that the next pass finds and splits.
+    std::vector<Vec3> p = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0},  {0, 0, 1},
+                           {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}, {0, 0, 0}};
+    std::vector<Triangle> t = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3},
+                               {7, 4, 5}, {7, 6, 4}, {7, 5, 6}, {4, 6, 5}};
+    SurfaceMesh mesh(p, t);
+    const SeparationReport first = separate(mesh, SeparationOptions{}, false, 0.5);
+    EXPECT_EQ(first.singular_vertices_split, 0);
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        EXPECT_FALSE(mesh.vertex_marked(vi)) << "regular vertex " << vi << " kept its mark";
+    for (int ti : std::vector<int>(mesh.vertex_triangles(7))) {
+        Triangle tri = mesh.triangle(ti);
+        for (int& v : tri)
+            v = v == 7 ? 0 : v;
+        mesh.remove_triangle(ti);
+        mesh.add_triangle(tri);
+    }
+    const SeparationReport second = separate(mesh, SeparationOptions{}, false, 0.5);
+    EXPECT_EQ(second.orphan_vertices_removed, 1);  // vertex 7
+    EXPECT_EQ(second.singular_vertices_split, 1);
+    EXPECT_EQ(vertex_fans(mesh, 0).size(), 1u);
+    EXPECT_TRUE(validate_mesh(mesh).empty());
+    EXPECT_EQ(triangle_components(mesh).count, 2);
+
+    // A triangle added against an old one of the opposite orientation (unmarked, from before the
+    // last pass) is a degenerate tetrahedron: both go.
+    const Triangle old = mesh.triangle(mesh.vertex_triangles(1)[0]);
+    const int old_ti = mesh.vertex_triangles(1)[0];
+    const int added = mesh.add_triangle({old[0], old[2], old[1]});
+    const SeparationReport third = separate(mesh, SeparationOptions{}, false, 0.5);
+    EXPECT_EQ(third.degenerate_tetrahedra_removed, 1);
+    EXPECT_FALSE(mesh.triangle_alive(old_ti));
+    EXPECT_FALSE(mesh.triangle_alive(added));
+}
+
 TEST(Separation, SplitsTwoSheetsThatShareAnEdge) {
     // Regression (issue #5): a dumbbell neck refined to an eighth of α and β (ξ = 0.02) collapsed
     // into two sheets sharing an edge of 4e-5 m with four triangles. Its triangles all counted as

@@ -57,8 +57,11 @@ TEST(MeshState, LoadsBackIntoAnyMeshWithTheSameBytes) {
     EXPECT_TRUE(saved(restored) == bytes) << "the restored state saves different bytes";
     EXPECT_TRUE(validate_mesh(restored).empty());
     ASSERT_EQ(restored.num_vertices(), original.num_vertices());
-    for (int i = 0; i < original.num_vertices(); ++i)
+    for (int i = 0; i < original.num_vertices(); ++i) {
         EXPECT_EQ(restored.position(i), original.position(i)) << "vertex " << i;
+        // The separation marks are not saved: all set, the next pass looks at everything.
+        EXPECT_TRUE(restored.vertex_marked(i)) << "vertex " << i;
+    }
 }
 
 TEST(MeshState, TruncatedStateIsRefusedLeavingTheMeshUnchanged) {

@@ -39,26 +39,29 @@ bool same_vertices(const Triangle& a, const Triangle& b) {
     return true;
 }
 
-/// Removes pairs of triangles on the same three vertices; returns how many pairs.
+/// Removes pairs of triangles on the same three vertices; returns how many pairs. Looks only at
+/// the triangles added since the last call (the mesh's triangle marks, cleared here): a group on
+/// the same vertices that none of them joined was left, the last time, with a single orientation
+/// and nothing to pair.
 int remove_degenerate_tetrahedra(SurfaceMesh& mesh) {
-    // Two triangles on the same vertices share every edge, so each finds the other among the
-    // triangles of its first edge: a pass over the triangles without sorting or allocation
-    // picks the few that are grouped below.
-    std::vector<std::uint8_t> duplicated(static_cast<size_t>(mesh.num_triangles()), 0);
-    tbb::parallel_for(0, mesh.num_triangles(), [&](int ti) {
-        if (!mesh.triangle_alive(ti))
-            return;
+    // Two triangles on the same vertices share every edge, so a new one finds the whole group
+    // among the triangles of its first edge, old members included.
+    std::vector<int> duplicated;
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_marked(ti) || !mesh.triangle_alive(ti))
+            continue;
         const Triangle& t = mesh.triangle(ti);
         for (int other : mesh.edge_triangles(mesh.triangle_edges(ti)[0]))
             if (other != ti && same_vertices(t, mesh.triangle(other))) {
-                duplicated[static_cast<size_t>(ti)] = 1;
-                return;
+                duplicated.push_back(ti);
+                duplicated.push_back(other);
             }
-    });
+    }
+    mesh.clear_triangle_marks();
+    std::sort(duplicated.begin(), duplicated.end());
+    duplicated.erase(std::unique(duplicated.begin(), duplicated.end()), duplicated.end());
     std::map<std::array<int, 3>, std::vector<int>> by_vertices;
-    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
-        if (!duplicated[static_cast<size_t>(ti)])
-            continue;
+    for (int ti : duplicated) {
         std::array<int, 3> key = mesh.triangle(ti);
         std::sort(key.begin(), key.end());
         by_vertices[key].push_back(ti);
@@ -260,26 +263,36 @@ SeparationReport separate(SurfaceMesh& mesh, const SeparationOptions& options,
     const auto start = std::chrono::steady_clock::now();
     SeparationReport report;
     report.degenerate_tetrahedra_removed = remove_degenerate_tetrahedra(mesh);
+    // Only marked vertices can have lost their triangles or their single fan (mesh.h): the
+    // others were found regular by an earlier pass and their triangles have not changed since.
+    std::vector<int> marked;
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        if (!mesh.vertex_marked(vi))
+            continue;
         if (mesh.vertex_alive(vi) && mesh.vertex_triangles(vi).empty()) {
             mesh.remove_vertex(vi);
             ++report.orphan_vertices_removed;
         }
+        marked.push_back(vi);
     }
 
     std::unique_ptr<ElementHash> hash;
-    const int vertex_count = mesh.num_vertices();
     // Splitting a singular vertex rewires only its own triangles, whose edges to a vertex with
     // one manifold fan stay manifold: such a vertex stays regular, and only the others (found in
-    // parallel) need the full fan analysis, in index order as before.
-    std::vector<std::uint8_t> regular(static_cast<size_t>(vertex_count), 0);
-    tbb::parallel_for(0, vertex_count, [&](int vi) {
-        regular[static_cast<size_t>(vi)] =
-            !mesh.vertex_alive(vi) || one_manifold_fan(mesh, vi) ? 1 : 0;
+    // parallel) need the full fan analysis, in index order. Their marks stay set (a split marks
+    // its vertices again, and one left joined is tried again next time); the regular lose theirs.
+    std::vector<std::uint8_t> regular(marked.size(), 0);
+    tbb::parallel_for(size_t{0}, marked.size(), [&](size_t k) {
+        const int vi = marked[k];
+        regular[k] = !mesh.vertex_alive(vi) || one_manifold_fan(mesh, vi) ? 1 : 0;
     });
-    for (int vi = 0; vi < vertex_count; ++vi) {
-        if (regular[static_cast<size_t>(vi)])
+    for (size_t k = 0; k < marked.size(); ++k)
+        if (regular[k])
+            mesh.clear_vertex_mark(marked[k]);
+    for (size_t k = 0; k < marked.size(); ++k) {
+        if (regular[k])
             continue;
+        const int vi = marked[k];
         const std::vector<std::vector<int>> fans = singular_vertex_fans(mesh, vi);
         if (fans.empty())
             continue;
