@@ -383,7 +383,14 @@ std::vector<int> SurfaceMesh::compact() {
                 list[kept++] = now;
         }
         list.resize(kept);
-        std::sort(list.begin(), list.end());
+        // Insertion sort: the lists are a valence long, and mostly sorted already.
+        for (size_t i = 1; i < kept; ++i) {
+            const int v = list[i];
+            size_t j = i;
+            for (; j > 0 && list[j - 1] > v; --j)
+                list[j] = list[j - 1];
+            list[j] = v;
+        }
     };
 
     // Vertices (the maps are increasing, so an element's new index never exceeds its old one
