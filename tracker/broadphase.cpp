@@ -358,13 +358,10 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
     m_cell = n > 0 && sum > 0.0 ? LOOSE_CELL_FACTOR * sum / n : 1.0;
     // Counting build in O(n): cells are numbered in order of first appearance, then ids are
     // placed cell by cell in increasing order (no sort).
-    size_t slots = 16;
-    while (slots < 2 * static_cast<size_t>(n))
-        slots *= 2;
-    const size_t mask = slots - 1;
-    m_slot_key.assign(slots, -1);
-    std::vector<int> slot_cell(slots, -1);
+    std::vector<Eigen::Array3i> coords_of(boxes.size());
     std::vector<int> cell_of(boxes.size(), -1);
+    Eigen::Array3i lo_all = Eigen::Array3i::Constant(std::numeric_limits<int>::max());
+    Eigen::Array3i hi_all = Eigen::Array3i::Constant(std::numeric_limits<int>::min());
     const double limit = (1 << 20) - 2;
     for (size_t i = 0; i < boxes.size(); ++i) {
         const Box3d& b = boxes[i];
@@ -376,17 +373,51 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
             m_oversized.push_back(static_cast<int>(i));
             continue;
         }
-        const Eigen::Array3i coords = lo.cast<int>();
-        const std::int64_t key = cell_key(coords);
-        size_t slot = mix(key) & mask;
-        while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
-            slot = (slot + 1) & mask;
-        if (m_slot_key[slot] == -1) {
+        coords_of[i] = lo.cast<int>();
+        cell_of[i] = 0;  // placed below
+        lo_all = lo_all.min(coords_of[i]);
+        hi_all = hi_all.max(coords_of[i]);
+    }
+    // A dense table when the block of occupied cells (with the one-cell rim the stencils and
+    // queries look at) is at most a few times the element count: a lookup is then an index
+    // computation instead of a hash probe.
+    const int placed = n - static_cast<int>(m_oversized.size());
+    if (placed > 0) {
+        const Eigen::Array3d size = (hi_all - lo_all + 3).cast<double>();
+        if (size.prod() <= std::max(8.0 * placed, 4096.0)) {
+            m_dense_lo = lo_all - 1;
+            m_dense_size = hi_all - lo_all + 3;
+            m_dense.assign(static_cast<size_t>(m_dense_size.prod()), -1);
+        }
+    }
+    size_t slots = 16;
+    while (m_dense.empty() && slots < 2 * static_cast<size_t>(n))
+        slots *= 2;
+    const size_t mask = slots - 1;
+    m_slot_key.assign(m_dense.empty() ? slots : 0, -1);
+    std::vector<int> slot_cell(m_slot_key.size(), -1);
+    for (size_t i = 0; i < boxes.size(); ++i) {
+        if (cell_of[i] < 0)
+            continue;
+        const Eigen::Array3i& coords = coords_of[i];
+        int* entry = nullptr;
+        if (!m_dense.empty()) {
+            const Eigen::Array3i d = coords - m_dense_lo;
+            entry = &m_dense[static_cast<size_t>(d.x() + m_dense_size.x() *
+                                                            (d.y() + m_dense_size.y() * d.z()))];
+        } else {
+            const std::int64_t key = cell_key(coords);
+            size_t slot = mix(key) & mask;
+            while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
+                slot = (slot + 1) & mask;
             m_slot_key[slot] = key;
-            slot_cell[slot] = static_cast<int>(m_cells.size());
+            entry = &slot_cell[slot];
+        }
+        if (*entry == -1) {
+            *entry = static_cast<int>(m_cells.size());
             m_cells.push_back({coords, 0, 0});
         }
-        const int c = slot_cell[slot];
+        const int c = *entry;
         cell_of[i] = c;
         ++m_cells[static_cast<size_t>(c)].end;  // count for now
     }
@@ -412,7 +443,16 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
             m_cell_union[c].extend(m_cell_boxes[static_cast<size_t>(k)]);
 }
 
-int LooseGrid::find_cell(std::int64_t key) const {
+int LooseGrid::find_cell(const Eigen::Array3i& coords) const {
+    if (!m_dense.empty()) {
+        const Eigen::Array3i d = coords - m_dense_lo;
+        if ((d < 0).any() || (d >= m_dense_size).any())
+            return -1;
+        return m_dense[static_cast<size_t>(d.x() + m_dense_size.x() * (d.y() + m_dense_size.y() * d.z()))];
+    }
+    if (m_slot_key.empty())
+        return -1;
+    const std::int64_t key = cell_key(coords);
     const size_t mask = m_slot_key.size() - 1;
     size_t slot = mix(key) & mask;
     while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
@@ -434,8 +474,8 @@ void LooseGrid::visit(size_t task, F&& f) const {
         // most of a cell's elements lie away from the face, edge or corner it shares.
         const Box3d& union_a = m_cell_union[task];
         for (const auto& offset : HALF_STENCIL) {
-            const int nb = find_cell(
-                cell_key(cell.coords + Eigen::Array3i(offset[0], offset[1], offset[2])));
+            const int nb =
+                find_cell(cell.coords + Eigen::Array3i(offset[0], offset[1], offset[2]));
             if (nb < 0)
                 continue;
             const Box3d& union_b = m_cell_union[static_cast<size_t>(nb)];
@@ -467,7 +507,7 @@ void LooseGrid::visit(size_t task, F&& f) const {
         for (int z = lo.z(); z <= hi.z(); ++z)
             for (int y = lo.y(); y <= hi.y(); ++y)
                 for (int x = lo.x(); x <= hi.x(); ++x) {
-                    const int c = find_cell(cell_key(Eigen::Array3i(x, y, z)));
+                    const int c = find_cell(Eigen::Array3i(x, y, z));
                     if (c < 0)
                         continue;
                     const Cell& cell = m_cells[static_cast<size_t>(c)];
@@ -507,7 +547,7 @@ void LooseGrid::query(const Box3d& box, std::vector<int>& out) const {
     for (int z = lo.z(); z <= hi.z(); ++z)
         for (int y = lo.y(); y <= hi.y(); ++y)
             for (int x = lo.x(); x <= hi.x(); ++x) {
-                const int c = find_cell(cell_key(Eigen::Array3i(x, y, z)));
+                const int c = find_cell(Eigen::Array3i(x, y, z));
                 if (c < 0 || !boxes_overlap(m_cell_union[static_cast<size_t>(c)], box))
                     continue;
                 const Cell& cell = m_cells[static_cast<size_t>(c)];

@@ -132,14 +132,18 @@ private:
         int begin, end;  // [begin, end) into m_ids
     };
     std::int64_t cell_key(const Eigen::Array3i& c) const;
-    /// Index into m_cells of the cell with `key`, −1 when no element lies there.
-    int find_cell(std::int64_t key) const;
+    /// Index into m_cells of the cell at `coords`, −1 when no element lies there.
+    int find_cell(const Eigen::Array3i& coords) const;
     const std::vector<Box3d>& m_boxes;
     double m_cell = 1.0;
     std::vector<int> m_ids;                         // ids grouped by cell
     std::vector<Box3d> m_cell_boxes;                // their boxes, same order (sequential reads)
     std::vector<std::int64_t> m_slot_key;           // flat hash: key per slot (−1 = empty)
     std::vector<int> m_slot_cell;                   // index into m_cells per slot (−1 = empty)
+    // Where the occupied cells fill a small enough block, a dense table over it replaces the
+    // hash (index into m_cells or −1; empty when the hash is used).
+    std::vector<int> m_dense;
+    Eigen::Array3i m_dense_lo = Eigen::Array3i::Zero(), m_dense_size = Eigen::Array3i::Zero();
     std::vector<Cell> m_cells;                      // occupied cells, first-appearance order
     std::vector<Box3d> m_cell_union;                // per cell: the union of its elements' boxes
     std::vector<int> m_oversized;

@@ -223,6 +223,25 @@ TEST(StaticEdgeEdgePairs, EqualBruteForceWithOversizedEdges) {
     }
 }
 
+// The loose grid finds cells through a dense table when the occupied cells fill a compact block
+// (the tests above) and through a hash when they are spread out: two small spheres a hundred
+// radii apart give the same pairs as brute force, for the self join and for the queries.
+TEST(StaticEdgeEdgePairs, EqualBruteForceWhenTheCellsAreSpreadOut) {
+    const SurfaceMesh m = meshed(
+        make_union({make_sphere({0, 0, 0}, 0.1), make_sphere({10.0, 3.0, -7.0}, 0.1)}), 0.03);
+    for (double padding : {0.0, 0.01}) {
+        const auto expected = brute_force_edge_edge_pairs(m, m.positions(), m.positions(), padding);
+        EXPECT_EQ(static_edge_edge_pairs(m, padding, [](int, int) { return true; }), expected)
+            << "padding " << padding;
+        const std::vector<Vec3> x1 = randomly_moved(m, 0.01, 7);
+        const BroadPhase broad(m, m.positions(), x1, padding);
+        EXPECT_EQ(broad.vertex_triangle_pairs().size(),
+                  brute_force_vertex_triangle_pairs(m, m.positions(), x1, padding).size());
+        EXPECT_EQ(broad.edge_edge_pairs().size(),
+                  brute_force_edge_edge_pairs(m, m.positions(), x1, padding).size());
+    }
+}
+
 TEST(MeshIntersections, GeneratedMeshesAreIntersectionFree) {
     for (const auto& shape :
          {make_sphere({0, 0, 0}, 0.3), make_torus({0, 0, 0}, {0, 0, 1}, 0.3, 0.05),

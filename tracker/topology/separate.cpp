@@ -282,17 +282,17 @@ SeparationReport separate(SurfaceMesh& mesh, const SeparationOptions& options,
     // parallel) need the full fan analysis, in index order. Their marks stay set (a split marks
     // its vertices again, and one left joined is tried again next time); the regular lose theirs.
     std::vector<std::uint8_t> regular(marked.size(), 0);
-    tbb::parallel_for(size_t{0}, marked.size(), [&](size_t k) {
-        const int vi = marked[k];
-        regular[k] = !mesh.vertex_alive(vi) || one_manifold_fan(mesh, vi) ? 1 : 0;
+    tbb::parallel_for(size_t{0}, marked.size(), [&](size_t m) {
+        const int vi = marked[m];
+        regular[m] = !mesh.vertex_alive(vi) || one_manifold_fan(mesh, vi) ? 1 : 0;
     });
-    for (size_t k = 0; k < marked.size(); ++k)
-        if (regular[k])
-            mesh.clear_vertex_mark(marked[k]);
-    for (size_t k = 0; k < marked.size(); ++k) {
-        if (regular[k])
+    for (size_t m = 0; m < marked.size(); ++m)
+        if (regular[m])
+            mesh.clear_vertex_mark(marked[m]);
+    for (size_t m = 0; m < marked.size(); ++m) {
+        if (regular[m])
             continue;
-        const int vi = marked[k];
+        const int vi = marked[m];
         const std::vector<std::vector<int>> fans = singular_vertex_fans(mesh, vi);
         if (fans.empty())
             continue;
