@@ -1,6 +1,6 @@
 #include "app/checkpoint.h"
 
-#include "app/run.h"
+#include "app/errors.h"
 #include "common/atomic_file.h"
 #include "common/binary_io.h"
 

@@ -4,7 +4,7 @@
 
 #include "app/fluid_measures.h"
 
-#include "app/run.h"
+#include "app/errors.h"
 #include "tracker/mesh_measures.h"
 
 #include <Eigen/Dense>

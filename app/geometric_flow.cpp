@@ -1,6 +1,6 @@
 #include "app/geometric_flow.h"
 
-#include "app/run.h"
+#include "app/errors.h"
 #include "tracker/mesh_measures.h"
 
 #include <cmath>

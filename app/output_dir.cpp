@@ -1,6 +1,6 @@
 #include "app/output_dir.h"
 
-#include "app/run.h"
+#include "app/errors.h"
 
 #include <cerrno>
 #include <cstdio>

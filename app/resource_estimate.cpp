@@ -1,6 +1,6 @@
 #include "app/resource_estimate.h"
 
-#include "app/run.h"
+#include "app/errors.h"
 
 #include <unistd.h>
 

@@ -6,21 +6,14 @@
 #include "app/output_dir.h"
 #include "app/progress.h"
 #include "app/resource_estimate.h"
-#include "app/surface_checks.h"
+#include "app/scene_setup.h"
 #include "common/atomic_file.h"
 #include "common/cancellation.h"
 #include "common/phase_clock.h"
 #include "coupling/simulation.h"
 #include "coupling/vdb_output.h"
-#include "tracker/flows/curl_noise.h"
-#include "tracker/flows/flow_errors.h"
 #include "tracker/flows/flow_runner.h"
-#include "tracker/flows/velocity_field.h"
-#include "tracker/implicit_mesher.h"
-#include "tracker/mesh_intersections.h"
-#include "tracker/mesh_io.h"
 #include "tracker/mesh_measures.h"
-#include "tracker/mesh_validate.h"
 #include "tracker/surface_tracker.h"
 
 #include <nlohmann/json.hpp>
@@ -45,10 +38,6 @@ using tracker::SurfaceMesh;
 using tracker::Vec3;
 using Clock = std::chrono::steady_clock;
 
-/// Violations listed in an error message before "and N more".
-constexpr size_t MAX_LISTED_VIOLATIONS = 5;
-/// The fluid grid's cells per axis are ints; its arrays are indexed by their products.
-constexpr double MAX_CELLS_PER_AXIS = 1 << 20;
 /// Geometric flows: a step that ends this close (fraction of /time/dt) to a stop lands on it.
 constexpr double TIME_SNAP_FRACTION = 1e-9;
 /// Geometric flows: the run stops (RunResult::stalled) after this many consecutive steps that
@@ -250,164 +239,8 @@ nlohmann::json frame_stats(int frame, double time, double dt, long long steps,
               {"output", work.output}}}};
 }
 
-/// Throws InputError listing the first intersecting triangle pairs, if any.
-void check_intersection_free(const SurfaceMesh& mesh, const std::string& what) {
-    const tracker::IntersectionReport r = tracker::find_self_intersections(mesh);
-    if (r.intersection_free())
-        return;
-    std::ostringstream s;
-    s << what << ": the surface intersects itself (" << r.triangle_pairs.size()
-      << " triangle pairs), e.g.";
-    for (size_t i = 0; i < r.triangle_pairs.size() && i < MAX_LISTED_VIOLATIONS; ++i)
-        s << " (" << r.triangle_pairs[i].ti << ", " << r.triangle_pairs[i].tj << ")";
-    throw InputError(s.str());
-}
-
-std::string format_length(double metres) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.4g m", metres);
-    return text;
-}
-
-/// "/surface/edge_length 0.02 m", or how a fluid scene derived it from the grid.
-std::string edge_length_keys(const Scene& scene) {
-    if (scene.flow.type == "fluid" && scene.coupling.edge_length_cells > 0.0)
-        return "edge length " + format_length(scene.surface.edge_length) +
-               " (/coupling/edge_length_cells x /domain/size/0 / /domain/cells)";
-    return "/surface/edge_length " + format_length(scene.surface.edge_length);
-}
-
-/// Total area of the triangles of `data` (m²).
-double mesh_data_area(const tracker::MeshData& data) {
-    double area = 0.0;
-    for (const tracker::Triangle& t : data.triangles) {
-        const Vec3& a = data.positions[static_cast<size_t>(t[0])];
-        area += 0.5 * (data.positions[static_cast<size_t>(t[1])] - a)
-                          .cross(data.positions[static_cast<size_t>(t[2])] - a)
-                          .norm();
-    }
-    return area;
-}
 
 }  // namespace
-
-/// The initial surface's geometry and connectivity (labels still the default: liquid inside).
-/// `preloaded`: the mesh file's contents when the caller has read them already.
-static SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::string* report,
-                                                  double* nominal_xi,
-                                                  const tracker::MeshData* preloaded = nullptr) {
-    if (scene.shape) {
-        tracker::ImplicitMeshOptions options;
-        options.edge_length = scene.surface.edge_length;
-        options.remesh_iterations = scene.surface.remesh_iterations;
-        options.crease = scene.surface.crease;
-        options.cancel = scene.cancel;
-        tracker::ImplicitMeshReport r;
-        SurfaceMesh mesh;
-        try {
-            mesh = tracker::mesh_implicit_shape(*scene.shape, options, &r);
-        } catch (const Cancelled&) {
-            throw;
-        } catch (const std::invalid_argument& e) {
-            throw InputError(scene.source_path + ": /surface/shape at " + edge_length_keys(scene) +
-                             ": " + e.what());
-        } catch (const std::runtime_error& e) {
-            throw InputError(scene.source_path + ": /surface/shape at " + edge_length_keys(scene) +
-                             ": " + e.what());
-        }
-        check_intersection_free(mesh, scene.source_path + ": /surface/shape meshed at " +
-                                          edge_length_keys(scene));
-        if (report) {
-            std::ostringstream s;
-            s << "meshed shape: " << r.vertices << " vertices, " << r.triangles
-              << " triangles, mean edge " << r.mean_edge_length << " m (requested "
-              << scene.surface.edge_length << "), angles " << r.min_angle_degrees << "°–"
-              << r.max_angle_degrees << "°";
-            if (r.crease_splits > 0)
-                s << ", " << r.crease_splits << " crease refinement splits around "
-                  << r.crease_vertices << " crease vertices";
-            *report = s.str();
-        }
-        if (nominal_xi)
-            *nominal_xi = r.nominal_characteristic_length();
-        return mesh;
-    }
-    const std::string& file = scene.surface.mesh_file;
-    const tracker::MeshData data = preloaded ? tracker::MeshData{} : read_surface_file(scene);
-    SurfaceMesh mesh = checked_surface_mesh(preloaded ? *preloaded : data, scene);
-    if (report) {
-        std::ostringstream s;
-        s << "loaded " << file << ": " << mesh.count_live_vertices() << " vertices, "
-          << mesh.count_live_triangles() << " triangles";
-        *report = s.str();
-    }
-    return mesh;
-}
-
-tracker::TrackerOptions tracker_options(const Scene& scene, double nominal_xi) {
-    tracker::TrackerOptions options = scene.tracker;
-    if (options.characteristic_length == 0.0)
-        options.characteristic_length = nominal_xi;
-    options.cancel = scene.cancel;
-    return options;
-}
-
-/// /surface/inside: which phase the surface encloses.
-static void set_inside_labels(SurfaceMesh& mesh, const Scene& scene) {
-    const tracker::LabelPair labels =
-        scene.surface.inside == "gas" ? tracker::LabelPair{0, 1} : tracker::LabelPair{1, 0};
-    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
-        if (mesh.triangle_alive(ti))
-            mesh.set_labels(ti, labels);
-}
-
-SurfaceMesh build_initial_surface(const Scene& scene, std::string* report, double* nominal_xi) {
-    if (nominal_xi)
-        *nominal_xi = 0.0;
-    SurfaceMesh mesh = build_initial_surface_geometry(scene, report, nominal_xi);
-    set_inside_labels(mesh, scene);
-    return mesh;
-}
-
-/// The initial surface of `meniscus run`, after every check that can be made before the large
-/// allocations: the output folder, the scene's scale, a surface that meets the fluid box, and
-/// the estimated memory and steps per frame against `options.limits`.
-static SurfaceMesh checked_initial_surface(const Scene& scene, const RunOptions& options,
-                                           std::string* report, double* nominal_xi) {
-    *nominal_xi = 0.0;
-    prepare_output_dir(options.out_dir);
-    SurfaceSize size;
-    tracker::MeshData data;
-    if (scene.shape) {
-        size = shape_surface_size(scene);
-        size.bounds = scene.shape->bounds();
-    } else {
-        data = read_surface_file(scene);
-        size.from_mesh_file = true;
-        size.triangles = static_cast<double>(data.triangles.size());
-        size.area = mesh_data_area(data);
-        for (const Vec3& p : data.positions)
-            size.bounds.extend(p);
-    }
-    const double frame_dt = scene.time.end / scene.time.frames;
-    check_resources(scene, estimate_resources(scene, size, frame_dt), options.limits);
-    check_scene_scale(scene);
-    if (scene.shape) {
-        const tracker::Box3 b = scene.shape->bounds();
-        check_surface_meets_fluid_box(scene, b.min(), b.max(), "/surface/shape");
-    }
-    SurfaceMesh mesh =
-        build_initial_surface_geometry(scene, report, nominal_xi, scene.shape ? nullptr : &data);
-    if (!scene.shape) {
-        Eigen::AlignedBox3d box;
-        for (const Vec3& p : data.positions)
-            box.extend(p);
-        check_surface_meets_fluid_box(scene, box.min(), box.max(),
-                                      "/surface/mesh_file " + scene.surface.mesh_file);
-    }
-    set_inside_labels(mesh, scene);
-    return mesh;
-}
 
 /// Turns an exception escaping a run's computation into what `meniscus run` reports: a stop
 /// request, a write error and bad input pass through; anything else is an internal failure at
@@ -442,25 +275,6 @@ bool should_stop(const RunOptions& options, const std::atomic<bool>& stop, doubl
     return true;
 }
 
-/// Sets every face whose centre lies inside a region's shape to that region's velocity.
-void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::MacGrid& grid,
-                            const CancellationToken& cancel) {
-    if (regions.empty())
-        return;
-    for (int axis = 0; axis < 3; ++axis) {
-        fluid::Array3<double>& u = grid.velocity(axis);
-        for (int k = 0; k < u.nk(); ++k) {
-            cancel.throw_if_requested("setting the initial velocity");
-            for (int j = 0; j < u.nj(); ++j)
-                for (int i = 0; i < u.ni(); ++i) {
-                    const Vec3 x = grid.face_centre(axis, i, j, k);
-                    for (const VelocityRegion& r : regions)
-                        if (r.shape->value(x) < 0.0)
-                            u(i, j, k) = r.velocity[axis];
-                }
-        }
-    }
-}
 
 /// Wall and process-CPU seconds of a frame's fluid steps per phase, summed over its steps, and
 /// of writing its files. stats.jsonl "seconds": the wall seconds by phase, the fluid step's own
@@ -696,35 +510,6 @@ SurfaceMesh placeholder_surface() {
                        {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}});
 }
 
-/// The coupled simulation of a fluid scene from its initial surface.
-static coupling::Simulation fluid_simulation(const Scene& scene, SurfaceMesh initial,
-                                             double nominal_xi) {
-    const double dx = scene.domain.size.x() / scene.domain.cells;
-    const auto cells_along = [&](double size, const char* key) {
-        const double n = std::round(size / dx);
-        if (!(n <= MAX_CELLS_PER_AXIS))
-            throw InputError(scene.source_path + ": " + key + ": " + std::to_string(n) +
-                             " cells of the /domain cell size; at most " +
-                             std::to_string(MAX_CELLS_PER_AXIS));
-        return std::max(1, static_cast<int>(n));
-    };
-    fluid::FluidOptions options = scene.fluid;
-    options.pressure.iteration.cancel = scene.cancel;
-    options.viscosity.iteration.cancel = scene.cancel;
-    fluid::FluidSolver solver(scene.domain.cells, cells_along(scene.domain.size.y(), "/domain/size/1"),
-                              cells_along(scene.domain.size.z(), "/domain/size/2"), dx,
-                              scene.domain.min, options);
-    apply_initial_velocity(scene.initial_velocity, solver.grid(), scene.cancel);
-    return coupling::Simulation(
-        tracker::SurfaceTracker(std::move(initial), tracker_options(scene, nominal_xi)),
-        std::move(solver), scene.coupling.simulation);
-}
-
-coupling::Simulation make_fluid_simulation(const Scene& scene, std::string* report) {
-    double nominal_xi = 0.0;
-    SurfaceMesh initial = build_initial_surface(scene, report, &nominal_xi);
-    return fluid_simulation(scene, std::move(initial), nominal_xi);
-}
 
 /// Runs a fluid scene, keeping `result` current frame by frame (a caller that catches an
 /// exception still knows what was written).
@@ -737,13 +522,14 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
     if (resume) {
         prepare_output_dir(options.out_dir);
         nominal_xi = resume->checkpoint.header.nominal_xi;
-        simulation.emplace(fluid_simulation(scene, placeholder_surface(), nominal_xi));
+        simulation.emplace(make_fluid_simulation(scene, placeholder_surface(), nominal_xi));
         restore_state(*resume, options, [&](BinaryReader& in) { simulation->load_state(in); });
         report = "resumed at frame " + std::to_string(resume->checkpoint.header.frame) +
                  " from " + options.out_dir + "/" + CHECKPOINT_NAME;
     } else {
-        SurfaceMesh initial = checked_initial_surface(scene, options, &report, &nominal_xi);
-        simulation.emplace(fluid_simulation(scene, std::move(initial), nominal_xi));
+        prepare_output_dir(options.out_dir);
+        SurfaceMesh initial = checked_initial_surface(scene, options.limits, &report, &nominal_xi);
+        simulation.emplace(make_fluid_simulation(scene, std::move(initial), nominal_xi));
     }
     coupling::Simulation& sim = *simulation;
     const double dx = sim.fluid().grid().dx();
@@ -867,7 +653,8 @@ static void run_geometric_scene(const Scene& scene, const RunOptions& options,
         report = "resumed at frame " + std::to_string(resume->checkpoint.header.frame) +
                  " from " + options.out_dir + "/" + CHECKPOINT_NAME;
     } else {
-        SurfaceMesh initial = checked_initial_surface(scene, options, &report, &nominal_xi);
+        prepare_output_dir(options.out_dir);
+        SurfaceMesh initial = checked_initial_surface(scene, options.limits, &report, &nominal_xi);
         surface_tracker.emplace(std::move(initial), tracker_options(scene, nominal_xi));
     }
     tracker::SurfaceTracker& tracker = *surface_tracker;

@@ -1,6 +1,8 @@
 #pragma once
-/// \file Running a scene: initial surface, time stepping, per-frame output.
+/// \file Running a scene: time stepping, per-frame output, checkpoints and resuming (the set-up
+/// before the first step is scene_setup.h).
 
+#include "app/errors.h"
 #include "app/resource_estimate.h"
 #include "app/scene.h"
 #include "tracker/mesh.h"
@@ -10,19 +12,6 @@
 #include <string>
 
 namespace meniscus::app {
-
-/// Bad user input outside the scene JSON itself (e.g. a broken mesh file): exit code 2.
-class InputError : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
-
-/// A fault inside Meniscus (not the input's): exit code 1. The message says where it happened
-/// (the step and frame) and what failed.
-class InternalFailure : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
 
 /// Command-line choices of `meniscus run`.
 struct RunOptions {
@@ -57,22 +46,6 @@ struct RunResult {
     double simulated_time = 0.0;
     long long steps = 0;
 };
-
-/// Builds the initial surface of a scene (meshing its shape or loading and validating its mesh
-/// file). Throws InputError naming the file and the failed check for a bad mesh file.
-/// `nominal_xi` gets the tracker's ξ when the mesh was refined around creases (its mean edge
-/// length before that refinement), else 0: measure it from the mesh.
-tracker::SurfaceMesh build_initial_surface(const Scene& scene, std::string* report = nullptr,
-                                           double* nominal_xi = nullptr);
-/// The scene's tracker options with ξ set to `nominal_xi` unless the scene fixes it (or
-/// `nominal_xi` is 0).
-tracker::TrackerOptions tracker_options(const Scene& scene, double nominal_xi);
-
-/// The coupled simulation of a fluid scene as `meniscus run` sets it up: the grid from /domain
-/// (cubic cells, /domain/cells along x), the initial surface from /surface (build_initial_surface(),
-/// whose `report` it passes on), the fluid at rest except for the /initial_velocity regions.
-/// Throws what build_initial_surface() and the fluid solver throw.
-coupling::Simulation make_fluid_simulation(const Scene& scene, std::string* report = nullptr);
 
 /// Runs the scene, writing frames into options.out_dir. Before anything large is allocated it
 /// checks the output folder (InputError), the scene's scale and the estimated memory and steps

@@ -1,6 +1,6 @@
 #include "app/surface_checks.h"
 
-#include "app/run.h"
+#include "app/errors.h"
 #include "tracker/mesh_intersections.h"
 #include "tracker/mesh_measures.h"
 #include "tracker/mesh_validate.h"

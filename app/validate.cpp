@@ -2,6 +2,7 @@
 /// of tracked runs (app/validate_run.h) measured against its exact or reference solution, and
 /// the driver that runs the selected cases of parts A and B and writes the report.
 
+#include "app/scene_setup.h"
 #include "app/validate.h"
 
 #include "app/validate_fluid.h"

@@ -3,6 +3,7 @@
 /// B1–B4 drive a coupling::Simulation step by step and measure the mesh after every step
 /// (app/fluid_measures.h); B5 is in validate_merge.cpp.
 
+#include "app/scene_setup.h"
 #include "app/validate_fluid.h"
 
 #include "app/fluid_measures.h"

@@ -4,6 +4,7 @@
 /// Hadamard–Rybczynski with the walls' exact image correction. Each at several resolutions at the
 /// solver's own Δt, the coarsest also at Δt/2 (and Δt/4 in full mode), as B1–B4.
 
+#include "app/scene_setup.h"
 #include "app/validate_viscous.h"
 
 #include "app/fluid_references.h"

@@ -1,5 +1,6 @@
 #include "app/validate_zalesak.h"
 
+#include "app/scene_setup.h"
 #include "app/validate_report.h"
 #include "tracker/flows/flow_errors.h"
 #include "tracker/flows/flow_runner.h"

@@ -36,6 +36,7 @@
 
 #include "app/run.h"
 #include "app/scene.h"
+#include "app/scene_setup.h"
 #include "common/phase_clock.h"
 #include "coupling/simulation.h"
 

@@ -4,6 +4,7 @@
 #include "app/frame_output.h"
 #include "app/run.h"
 #include "app/scene.h"
+#include "app/scene_setup.h"
 
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>

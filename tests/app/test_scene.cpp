@@ -1,6 +1,7 @@
 #include "app/json_fields.h"
 #include "app/run.h"
 #include "app/scene.h"
+#include "app/scene_setup.h"
 #include "tracker/mesh_measures.h"
 
 #include <gtest/gtest.h>

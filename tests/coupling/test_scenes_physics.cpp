@@ -11,6 +11,7 @@
 #include "app/scene.h"
 #include "app/fluid_measures.h"
 #include "app/fluid_references.h"
+#include "app/scene_setup.h"
 #include "tracker/mesh_io.h"
 #include "tracker/mesh_measures.h"
 
