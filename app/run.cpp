@@ -2,6 +2,7 @@
 
 #include "app/checkpoint.h"
 #include "app/frame_output.h"
+#include "app/frame_writer.h"
 #include "app/geometric_flow.h"
 #include "app/output_dir.h"
 #include "app/progress.h"
@@ -19,13 +20,11 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -65,140 +64,6 @@ struct FrameWork {
     /// topology changes, by the flow's motion as requested (shortened by the fraction collision
     /// handling applied), and by what collision handling changed of that motion.
     double volume_remeshing = 0.0, volume_motion = 0.0, volume_collisions = 0.0;
-};
-
-/// The run's output folder. A frame is complete as a set: its files are written first (each
-/// atomically), its line of stats.jsonl next, then the sidecar meniscus.json that counts it, so a
-/// frame whose line is missing was cut short. When one file of a frame fails, the frame's files
-/// already written are removed again; an earlier run's files are removed first (frame_output.h).
-class FrameWriter {
-public:
-    /// `frames`: the frames the run will write after frame 0.
-    FrameWriter(const Scene& scene, const RunOptions& options, int frames)
-        : m_scene(scene),
-          m_dir(options.out_dir),
-          m_stats_path((std::filesystem::path(options.out_dir) / STATS_NAME).string()),
-          m_format(frame_format(scene)),
-          m_frames(frames) {
-        const std::vector<std::string> removed = remove_earlier_run(m_dir);
-        if (!removed.empty() && !options.quiet)
-            std::fprintf(stderr, "%s: removed %zu files of an earlier run (%s ... %s)\n",
-                         m_dir.c_str(), removed.size(), removed.front().c_str(),
-                         removed.back().c_str());
-        std::filesystem::create_directories(m_dir);
-        errno = 0;
-        m_stats.open(m_stats_path, std::ios::trunc);
-        if (!m_stats)
-            throw WriteError(m_stats_path + ": cannot open for writing: " +
-                             system_reason(errno, "open failed"));
-    }
-
-    /// A resumed run continues the folder of the run that wrote `checkpoint`: frames after the
-    /// checkpoint's frame (and temporaries) are removed, stats.jsonl is cut back to the lines
-    /// of frames 0 to that frame (the frame's own line restored from the checkpoint when the
-    /// kill came before it was written), and new lines are appended. `checkpoint_bytes`: the
-    /// checkpoint file's size (for a restored line).
-    FrameWriter(const Scene& scene, const RunOptions& options, int frames,
-                const CheckpointHeader& checkpoint, std::uint64_t checkpoint_bytes)
-        : m_scene(scene),
-          m_dir(options.out_dir),
-          m_stats_path((std::filesystem::path(options.out_dir) / STATS_NAME).string()),
-          m_format(frame_format(scene)),
-          m_frames(frames) {
-        const std::vector<std::string> removed = remove_frames_after(m_dir, checkpoint.frame);
-        if (!removed.empty() && !options.quiet)
-            std::fprintf(stderr, "%s: removed %zu files written after the checkpoint (%s ... %s)\n",
-                         m_dir.c_str(), removed.size(), removed.front().c_str(),
-                         removed.back().c_str());
-        std::string kept;
-        {
-            std::ifstream in(m_stats_path, std::ios::binary);
-            std::string line;
-            int lines = 0;
-            while (lines <= checkpoint.frame && std::getline(in, line)) {
-                if (in.eof())
-                    break;  // a last line without its newline was cut short
-                kept += line + '\n';
-                ++lines;
-            }
-            if (lines == checkpoint.frame) {
-                nlohmann::json restored = nlohmann::json::parse(checkpoint.stats_line);
-                restored["seconds"] = nullptr;  // the interrupted run's timings are lost
-                restored["checkpoint"] = {{"bytes", checkpoint_bytes}, {"seconds", nullptr}};
-                kept += restored.dump() + '\n';
-            } else if (lines < checkpoint.frame) {
-                throw InputError(m_stats_path + ": has " + std::to_string(lines) +
-                                 " complete lines, but the checkpoint is at frame " +
-                                 std::to_string(checkpoint.frame) +
-                                 ": the folder does not belong to the checkpoint");
-            }
-        }
-        errno = 0;
-        m_stats.open(m_stats_path, std::ios::binary | std::ios::trunc);
-        m_stats << kept;
-        m_stats.flush();
-        if (!m_stats)
-            throw WriteError(m_stats_path + ": cannot write: " +
-                             system_reason(errno, "write failed"));
-        m_stats_bytes = kept.size();
-    }
-
-    /// Writes the frame's files; returns seconds spent.
-    double write(int frame, const SurfaceMesh& mesh, const std::vector<Vec3>& velocities,
-                 const coupling::FluidFields& fluid = {}) {
-        const auto start = Clock::now();
-        m_frame_files = write_frame_files(m_dir, frame, m_format, mesh, velocities, fluid);
-        m_pending_frame = frame;
-        return seconds_since(start);
-    }
-
-    /// Appends the frame's line to stats.jsonl (what marks the frame complete), then rewrites
-    /// the sidecar to count the frame. When the line cannot be written whole, stats.jsonl is cut
-    /// back to its complete lines and the frame's files are removed, so no frame is left
-    /// half-recorded.
-    void stats(const nlohmann::json& line) {
-        const std::string text = line.dump() + '\n';
-        errno = 0;
-        m_stats << text;
-        m_stats.flush();
-        if (!m_stats) {
-            const std::string reason = system_reason(errno, "the stream reported an error");
-            m_stats.close();
-            std::error_code ec;
-            std::filesystem::resize_file(m_stats_path, m_stats_bytes, ec);
-            remove_files(m_frame_files);
-            throw WriteError(m_stats_path + ": write failed: " + reason);
-        }
-        m_stats_bytes += text.size();
-        m_frame_files.clear();
-        if (m_pending_frame >= 0)
-            write_run_sidecar(m_dir, run_sidecar(m_scene, m_format, m_pending_frame + 1,
-                                                 m_frames + 1, m_pending_frame == m_frames));
-        m_pending_frame = -1;
-    }
-
-    /// Removes the files of the frame whose line is not written yet (its checkpoint failed).
-    void discard_pending() {
-        remove_files(m_frame_files);
-        m_frame_files.clear();
-        m_pending_frame = -1;
-    }
-
-private:
-    static void remove_files(const std::vector<std::string>& paths) {
-        for (const std::string& path : paths)
-            std::remove(path.c_str());
-    }
-
-    const Scene& m_scene;
-    std::string m_dir;
-    std::string m_stats_path;
-    FrameFormat m_format;
-    int m_frames = 0;
-    std::ofstream m_stats;
-    std::uintmax_t m_stats_bytes = 0;       ///< bytes of complete lines in stats.jsonl
-    std::vector<std::string> m_frame_files;  ///< files of the frame whose line is not written yet
-    int m_pending_frame = -1;                ///< the frame those files belong to
 };
 
 nlohmann::json frame_stats(int frame, double time, double dt, long long steps,
@@ -544,9 +409,10 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
     const double end_time = frame_dt * frames;
     std::optional<FrameWriter> frame_writer;
     if (resume)
-        frame_writer.emplace(scene, options, frames, resume->checkpoint.header, resume->bytes);
+        frame_writer.emplace(scene, options.out_dir, options.quiet, frames,
+                             resume->checkpoint.header, resume->bytes);
     else
-        frame_writer.emplace(scene, options, frames);
+        frame_writer.emplace(scene, options.out_dir, options.quiet, frames);
     FrameWriter& writer = *frame_writer;
     Checkpointer checkpointer(scene, options, frames, nominal_xi);
     const auto save = [&](BinaryWriter& out) { sim.save_state(out); };
@@ -669,9 +535,10 @@ static void run_geometric_scene(const Scene& scene, const RunOptions& options,
 
     std::optional<FrameWriter> frame_writer;
     if (resume)
-        frame_writer.emplace(scene, options, frames, resume->checkpoint.header, resume->bytes);
+        frame_writer.emplace(scene, options.out_dir, options.quiet, frames,
+                             resume->checkpoint.header, resume->bytes);
     else
-        frame_writer.emplace(scene, options, frames);
+        frame_writer.emplace(scene, options.out_dir, options.quiet, frames);
     FrameWriter& writer = *frame_writer;
     Checkpointer checkpointer(scene, options, frames, nominal_xi);
     Progress progress(stderr, options.quiet);
