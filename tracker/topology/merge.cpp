@@ -163,9 +163,11 @@ MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& optio
         return std::tie(x.a, x.b) < std::tie(y.a, y.b);
     });
 
+    // The exact intersection test's hash, built when the first candidate gets that far: most
+    // candidates are refused by the cheap checks before it (a merge nearby, a shared vertex, an
+    // existing edge), and a step with only such candidates never builds it. No merge happens
+    // before it is built, so it sees the same mesh as one built here.
     std::unique_ptr<ElementHash> hash;
-    if (context.collision_safety)
-        hash = std::make_unique<ElementHash>(mesh, context.xi);
 
     const double spacing = options.merge_spacing_fraction * context.xi;
     std::vector<Vec3> merged_at;
@@ -207,6 +209,8 @@ MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& optio
                 existing_edge = true;
                 continue;
             }
+            if (context.collision_safety && !hash)
+                hash = std::make_unique<ElementHash>(mesh, context.xi);
             if (hash && merge_intersects(mesh, *hash, hole_a, hole_b, band))
                 continue;
             found = true;
