@@ -383,35 +383,32 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
     // computation instead of a hash probe.
     const int placed = n - static_cast<int>(m_oversized.size());
     if (placed > 0) {
-        const Eigen::Array3d size = (hi_all - lo_all + 3).cast<double>();
-        if (size.prod() <= std::max(8.0 * placed, 4096.0)) {
+        const Eigen::Array3i block = hi_all - lo_all + 3;
+        if (block.cast<double>().prod() <= std::max(8.0 * placed, 4096.0)) {
             m_dense_lo = lo_all - 1;
-            m_dense_size = hi_all - lo_all + 3;
-            m_dense.assign(static_cast<size_t>(m_dense_size.prod()), -1);
+            m_dense_size = block;
+            m_dense.assign(static_cast<size_t>(block.prod()), -1);
         }
     }
-    size_t slots = 16;
-    while (m_dense.empty() && slots < 2 * static_cast<size_t>(n))
-        slots *= 2;
-    const size_t mask = slots - 1;
-    m_slot_key.assign(m_dense.empty() ? slots : 0, -1);
-    std::vector<int> slot_cell(m_slot_key.size(), -1);
+    if (m_dense.empty()) {
+        size_t slots = 16;
+        while (slots < 2 * static_cast<size_t>(n))
+            slots *= 2;
+        m_slot_key.assign(slots, -1);
+        m_slot_cell.assign(slots, -1);
+    }
     for (size_t i = 0; i < boxes.size(); ++i) {
         if (cell_of[i] < 0)
             continue;
         const Eigen::Array3i& coords = coords_of[i];
         int* entry = nullptr;
         if (!m_dense.empty()) {
-            const Eigen::Array3i d = coords - m_dense_lo;
-            entry = &m_dense[static_cast<size_t>(d.x() + m_dense_size.x() *
-                                                            (d.y() + m_dense_size.y() * d.z()))];
+            entry = &m_dense[dense_slot(coords)];
         } else {
             const std::int64_t key = cell_key(coords);
-            size_t slot = mix(key) & mask;
-            while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
-                slot = (slot + 1) & mask;
+            const size_t slot = hash_slot(key);
             m_slot_key[slot] = key;
-            entry = &slot_cell[slot];
+            entry = &m_slot_cell[slot];
         }
         if (*entry == -1) {
             *entry = static_cast<int>(m_cells.size());
@@ -436,11 +433,23 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
         m_ids[pos] = static_cast<int>(i);
         m_cell_boxes[pos] = boxes[i];
     }
-    m_slot_cell = std::move(slot_cell);
     m_cell_union.resize(m_cells.size());  // default: empty
     for (size_t c = 0; c < m_cells.size(); ++c)
         for (int k = m_cells[c].begin; k < m_cells[c].end; ++k)
             m_cell_union[c].extend(m_cell_boxes[static_cast<size_t>(k)]);
+}
+
+size_t LooseGrid::hash_slot(std::int64_t key) const {
+    const size_t mask = m_slot_key.size() - 1;
+    size_t slot = mix(key) & mask;
+    while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
+        slot = (slot + 1) & mask;
+    return slot;
+}
+
+size_t LooseGrid::dense_slot(const Eigen::Array3i& coords) const {
+    const Eigen::Array3i d = coords - m_dense_lo;
+    return static_cast<size_t>(d.x() + m_dense_size.x() * (d.y() + m_dense_size.y() * d.z()));
 }
 
 int LooseGrid::find_cell(const Eigen::Array3i& coords) const {
@@ -448,15 +457,12 @@ int LooseGrid::find_cell(const Eigen::Array3i& coords) const {
         const Eigen::Array3i d = coords - m_dense_lo;
         if ((d < 0).any() || (d >= m_dense_size).any())
             return -1;
-        return m_dense[static_cast<size_t>(d.x() + m_dense_size.x() * (d.y() + m_dense_size.y() * d.z()))];
+        return m_dense[dense_slot(coords)];
     }
     if (m_slot_key.empty())
         return -1;
     const std::int64_t key = cell_key(coords);
-    const size_t mask = m_slot_key.size() - 1;
-    size_t slot = mix(key) & mask;
-    while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
-        slot = (slot + 1) & mask;
+    const size_t slot = hash_slot(key);
     return m_slot_key[slot] == -1 ? -1 : m_slot_cell[slot];
 }
 

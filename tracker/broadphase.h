@@ -134,6 +134,10 @@ private:
     std::int64_t cell_key(const Eigen::Array3i& c) const;
     /// Index into m_cells of the cell at `coords`, −1 when no element lies there.
     int find_cell(const Eigen::Array3i& coords) const;
+    /// The flat hash's slot of `key`: where it is stored, or the empty slot where it would go.
+    size_t hash_slot(std::int64_t key) const;
+    /// The dense table's entry of the cell at `coords` (which must lie in the table's block).
+    size_t dense_slot(const Eigen::Array3i& coords) const;
     const std::vector<Box3d>& m_boxes;
     double m_cell = 1.0;
     std::vector<int> m_ids;                         // ids grouped by cell
