@@ -157,13 +157,17 @@ int SurfaceMesh::other_vertex(int ei, int vi) const {
     return e[0] == vi ? e[1] : e[0];
 }
 
-int SurfaceMesh::add_vertex(const Vec3& p) {
+int SurfaceMesh::append_vertex_slot(const Vec3& p) {
     m_positions.push_back(p);
     m_vertex_alive.push_back(1);
     m_vertex_marked.push_back(1);
     m_vertex_triangles.emplace_back();
     m_vertex_edges.emplace_back();
-    const int vi = num_vertices() - 1;
+    return num_vertices() - 1;
+}
+
+int SurfaceMesh::add_vertex(const Vec3& p) {
+    const int vi = append_vertex_slot(p);
     for (MeshObserver* o : m_observers)
         o->on_vertex_added(vi);
     return vi;
@@ -253,12 +257,7 @@ int SurfaceMesh::split_edge(int ei, const Vec3& position, double s) {
     MENISCUS_ASSERT(edge_alive(ei), "splitting a dead edge");
     const Edge e = edge(ei);
     const std::vector<int> incident = edge_triangles(ei);
-    const int m = num_vertices();
-    m_positions.push_back(position);
-    m_vertex_alive.push_back(1);
-    m_vertex_marked.push_back(1);
-    m_vertex_triangles.emplace_back();
-    m_vertex_edges.emplace_back();
+    const int m = append_vertex_slot(position);
     for (int ti : incident) {
         const Triangle t = triangle(ti);
         const LabelPair l = labels(ti);
@@ -326,12 +325,7 @@ void SurfaceMesh::collapse_edge(int ei, int kept_vi, const Vec3& position, doubl
 
 int SurfaceMesh::duplicate_vertex(int vi, const std::vector<int>& triangles,
                                   const Vec3& copy_position) {
-    const int copy = num_vertices();
-    m_positions.push_back(copy_position);
-    m_vertex_alive.push_back(1);
-    m_vertex_marked.push_back(1);
-    m_vertex_triangles.emplace_back();
-    m_vertex_edges.emplace_back();
+    const int copy = append_vertex_slot(copy_position);
     for (int ti : triangles) {
         Triangle t = triangle(ti);
         if (!contains(t, vi))

@@ -197,6 +197,8 @@ public:
     void remove_observer(MeshObserver* observer);
 
 private:
+    /// Appends a live, marked vertex without triangles (observers are not told); returns it.
+    int append_vertex_slot(const Vec3& p);
     int add_edge(int v0, int v1);
     void remove_edge(int ei);
     void attach_triangle(int ti);
