@@ -5,19 +5,14 @@
 #include "app/scene_schema.h"
 #include "app/scene_shapes.h"
 
-#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <sstream>
 
 namespace meniscus::app {
 
 namespace {
-
-using tracker::ShapePtr;
-using Vec3 = Eigen::Vector3d;
 
 /// A scene file larger than this is refused before it is read (scenes are small; meshes go in
 /// mesh_file).
