@@ -2,12 +2,12 @@
 
 #include "common/assert.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace meniscus::tracker {
 
@@ -26,6 +26,79 @@ bool contains(const Triangle& t, int vi) {
 
 constexpr Triangle DEAD_TRIANGLE = {INVALID_INDEX, INVALID_INDEX, INVALID_INDEX};
 constexpr Edge DEAD_EDGE = {INVALID_INDEX, INVALID_INDEX};
+
+/// A renumbering of one kind of element: `map` is old → new (INVALID_INDEX for dead slots),
+/// `moved` the old indices of the elements that get a new index, in increasing new index, and
+/// `count` the live count.
+struct Renumbering {
+    std::vector<int> map;
+    std::vector<int> moved;
+    int count = 0;
+};
+
+/// compact()'s renumbering: live elements below the live count keep their index, and those
+/// above it fill the dead slots below it, lowest first.
+template <typename IsAlive>
+Renumbering fill_dead_slots(size_t slots, IsAlive alive) {
+    Renumbering r;
+    r.map.assign(slots, INVALID_INDEX);
+    for (size_t i = 0; i < slots; ++i)
+        if (alive(i)) {
+            r.map[i] = static_cast<int>(i);
+            ++r.count;
+        }
+    size_t hole = 0;
+    for (size_t i = static_cast<size_t>(r.count); i < slots; ++i) {
+        if (r.map[i] == INVALID_INDEX)
+            continue;
+        while (r.map[hole] != INVALID_INDEX)
+            ++hole;
+        r.map[i] = static_cast<int>(hole++);
+        r.moved.push_back(static_cast<int>(i));
+    }
+    return r;
+}
+
+/// Marks `index` in `seen` and appends it to `list` the first time.
+void collect_once(int index, std::vector<std::uint8_t>& seen, std::vector<int>& list) {
+    if (!seen[static_cast<size_t>(index)]) {
+        seen[static_cast<size_t>(index)] = 1;
+        list.push_back(index);
+    }
+}
+
+/// Bits 0..20 of x, y and z interleaved (x lowest): the position along the Z-order curve.
+std::uint64_t morton_code(std::uint64_t x, std::uint64_t y, std::uint64_t z) {
+    const auto spread = [](std::uint64_t b) {  // bit i to bit 3i
+        b &= 0x1fffff;
+        b = (b | b << 32) & 0x1f00000000ffffULL;
+        b = (b | b << 16) & 0x1f0000ff0000ffULL;
+        b = (b | b << 8) & 0x100f00f00f00f00fULL;
+        b = (b | b << 4) & 0x10c30c30c30c30c3ULL;
+        b = (b | b << 2) & 0x1249249249249249ULL;
+        return b;
+    };
+    return spread(x) | spread(y) << 1 | spread(z) << 2;
+}
+
+/// The renumbering that sorts elements by (key, old index); `moved` lists every element.
+Renumbering renumbering_by(std::vector<std::pair<std::uint64_t, int>>& keys) {
+    std::sort(keys.begin(), keys.end());
+    Renumbering r;
+    r.count = static_cast<int>(keys.size());
+    r.map.resize(keys.size());
+    r.moved.resize(keys.size());
+    for (size_t n = 0; n < keys.size(); ++n) {
+        r.map[static_cast<size_t>(keys[n].second)] = static_cast<int>(n);
+        r.moved[n] = keys[n].second;
+    }
+    return r;
+}
+
+void remap_list(std::vector<int>& list, const std::vector<int>& map) {
+    for (int& i : list)
+        i = map[static_cast<size_t>(i)];
+}
 
 }  // namespace
 
@@ -349,109 +422,203 @@ void SurfaceMesh::clear_triangle_marks() {
 }
 
 std::vector<int> SurfaceMesh::compact() {
-    // The result is exactly the mesh SurfaceMesh(live positions, live triangles, labels) would
-    // build — edges numbered in order of first appearance around the live triangles, every
-    // adjacency list in increasing index order — but renumbered in place: no edge lookups, no
-    // reallocation of the adjacency lists.
-    std::vector<int> vertex_map(m_positions.size(), INVALID_INDEX);
-    int nv = 0;
-    for (size_t vi = 0; vi < m_positions.size(); ++vi)
-        if (m_vertex_alive[vi])
-            vertex_map[vi] = nv++;
-    std::vector<int> triangle_map(m_triangles.size(), INVALID_INDEX);
-    std::vector<int> edge_map(m_edges.size(), INVALID_INDEX);
-    int nt = 0, ne = 0;
-    for (size_t ti = 0; ti < m_triangles.size(); ++ti) {
-        if (m_triangles[ti][0] < 0)
-            continue;
-        triangle_map[ti] = nt++;
-        for (int ei : m_triangle_edges[ti])
-            if (edge_map[static_cast<size_t>(ei)] == INVALID_INDEX)
-                edge_map[static_cast<size_t>(ei)] = ne++;
-    }
-    const auto remap_sorted = [](std::vector<int>& list, const std::vector<int>& map) {
-        size_t kept = 0;
-        for (int old : list) {
-            const int now = map[static_cast<size_t>(old)];
-            if (now != INVALID_INDEX)
-                list[kept++] = now;
-        }
-        list.resize(kept);
-        // Insertion sort: the lists are a valence long, and mostly sorted already.
-        for (size_t i = 1; i < kept; ++i) {
-            const int v = list[i];
-            size_t j = i;
-            for (; j > 0 && list[j - 1] > v; --j)
-                list[j] = list[j - 1];
-            list[j] = v;
-        }
-    };
+    // Each kind of element keeps its indices below its live count; the live elements above it
+    // move into the dead slots below it (fill_dead_slots). Only the records that reference a
+    // moved element are rewritten, and no list is reordered, so the cost follows the number of
+    // dead slots rather than the size of the mesh.
+    const Renumbering vr =
+        fill_dead_slots(m_positions.size(), [&](size_t i) { return m_vertex_alive[i] != 0; });
+    const Renumbering tr =
+        fill_dead_slots(m_triangles.size(), [&](size_t i) { return m_triangles[i][0] >= 0; });
+    const Renumbering er =
+        fill_dead_slots(m_edges.size(), [&](size_t i) { return m_edges[i][0] >= 0; });
 
-    // Vertices (the maps are increasing, so an element's new index never exceeds its old one
-    // and moving forward in place is safe).
-    for (size_t vi = 0; vi < m_positions.size(); ++vi) {
-        const int now = vertex_map[vi];
-        if (now == INVALID_INDEX)
-            continue;
-        const size_t n = static_cast<size_t>(now);
-        m_positions[n] = m_positions[vi];
-        m_vertex_marked[n] = m_vertex_marked[vi];
-        if (n != vi) {
-            m_vertex_triangles[n] = std::move(m_vertex_triangles[vi]);
-            m_vertex_edges[n] = std::move(m_vertex_edges[vi]);
-        }
+    // The records that hold a reference to a moved element (old indices, each once), found
+    // through the moved element's own adjacency while every index is still the old one.
+    std::vector<std::uint8_t> seen_v(m_positions.size(), 0), seen_t(m_triangles.size(), 0),
+        seen_e(m_edges.size(), 0);
+    std::vector<int> holders_v, holders_t, holders_e;
+    for (int vi : vr.moved) {
+        for (int ti : m_vertex_triangles[static_cast<size_t>(vi)])
+            collect_once(ti, seen_t, holders_t);
+        for (int ei : m_vertex_edges[static_cast<size_t>(vi)])
+            collect_once(ei, seen_e, holders_e);
     }
-    m_positions.resize(static_cast<size_t>(nv));
-    m_vertex_alive.assign(static_cast<size_t>(nv), 1);
-    m_vertex_marked.resize(static_cast<size_t>(nv));
-    m_vertex_triangles.resize(static_cast<size_t>(nv));
-    m_vertex_edges.resize(static_cast<size_t>(nv));
-    tbb::parallel_for(0, nv, [&](int vi) {
-        remap_sorted(m_vertex_triangles[static_cast<size_t>(vi)], triangle_map);
-        remap_sorted(m_vertex_edges[static_cast<size_t>(vi)], edge_map);
-    });
+    for (int ti : tr.moved) {
+        for (int vi : m_triangles[static_cast<size_t>(ti)])
+            collect_once(vi, seen_v, holders_v);
+        for (int ei : m_triangle_edges[static_cast<size_t>(ti)])
+            collect_once(ei, seen_e, holders_e);
+    }
+    for (int ei : er.moved) {
+        for (int vi : m_edges[static_cast<size_t>(ei)])
+            collect_once(vi, seen_v, holders_v);
+        for (int ti : m_edge_triangles[static_cast<size_t>(ei)])
+            collect_once(ti, seen_t, holders_t);
+    }
 
-    // Triangles.
-    for (size_t ti = 0; ti < triangle_map.size(); ++ti) {
-        const int now = triangle_map[ti];
-        if (now == INVALID_INDEX)
-            continue;
-        const size_t n = static_cast<size_t>(now);
-        const Triangle t = m_triangles[ti];
-        const std::array<int, 3> e = m_triangle_edges[ti];
+    // Their references renumbered in place (each holder once, so each index is mapped once).
+    for (int ti : holders_t) {
+        for (int& vi : m_triangles[static_cast<size_t>(ti)])
+            vi = vr.map[static_cast<size_t>(vi)];
+        for (int& ei : m_triangle_edges[static_cast<size_t>(ti)])
+            ei = er.map[static_cast<size_t>(ei)];
+    }
+    for (int ei : holders_e) {
+        Edge& e = m_edges[static_cast<size_t>(ei)];
+        e = {vr.map[static_cast<size_t>(e[0])], vr.map[static_cast<size_t>(e[1])]};
+        if (e[0] > e[1])
+            std::swap(e[0], e[1]);  // smaller index first
+        remap_list(m_edge_triangles[static_cast<size_t>(ei)], tr.map);
+    }
+    for (int vi : holders_v) {
+        remap_list(m_vertex_triangles[static_cast<size_t>(vi)], tr.map);
+        remap_list(m_vertex_edges[static_cast<size_t>(vi)], er.map);
+    }
+
+    // The moved records into their new slots, then the tails cut off.
+    for (int from : vr.moved) {
+        const size_t f = static_cast<size_t>(from), to = static_cast<size_t>(vr.map[f]);
+        m_positions[to] = m_positions[f];
+        m_vertex_alive[to] = 1;
+        m_vertex_marked[to] = m_vertex_marked[f];
+        m_vertex_triangles[to] = std::move(m_vertex_triangles[f]);
+        m_vertex_edges[to] = std::move(m_vertex_edges[f]);
+    }
+    const size_t nv = static_cast<size_t>(vr.count);
+    m_positions.resize(nv);
+    m_vertex_alive.resize(nv);
+    m_vertex_marked.resize(nv);
+    m_vertex_triangles.resize(nv);
+    m_vertex_edges.resize(nv);
+
+    for (int from : tr.moved) {
+        const size_t f = static_cast<size_t>(from), to = static_cast<size_t>(tr.map[f]);
+        m_triangles[to] = m_triangles[f];
+        m_triangle_edges[to] = m_triangle_edges[f];
+        m_labels[to] = m_labels[f];
+        m_triangle_marked[to] = m_triangle_marked[f];
+    }
+    const size_t nt = static_cast<size_t>(tr.count);
+    m_triangles.resize(nt);
+    m_triangle_edges.resize(nt);
+    m_labels.resize(nt);
+    m_triangle_marked.resize(nt);
+
+    for (int from : er.moved) {
+        const size_t f = static_cast<size_t>(from), to = static_cast<size_t>(er.map[f]);
+        m_edges[to] = m_edges[f];
+        m_edge_triangles[to] = std::move(m_edge_triangles[f]);
+    }
+    const size_t ne = static_cast<size_t>(er.count);
+    m_edges.resize(ne);
+    m_edge_triangles.resize(ne);
+
+    for (MeshObserver* o : m_observers)
+        o->on_compact(vr.map);
+    return vr.map;
+}
+
+double SurfaceMesh::far_edge_fraction() const {
+    const int window = std::max(64, count_live_vertices() / 32);
+    size_t live = 0, far = 0;
+    for (const Edge& e : m_edges)
+        if (e[0] >= 0) {
+            ++live;
+            far += std::abs(e[1] - e[0]) > window ? 1 : 0;
+        }
+    return live == 0 ? 0.0 : static_cast<double>(far) / static_cast<double>(live);
+}
+
+std::vector<int> SurfaceMesh::sort_spatially() {
+    if (has_dead_elements())
+        throw std::logic_error(
+            "SurfaceMesh::sort_spatially: the mesh has dead slots (compact() first)");
+    const size_t nv = m_positions.size(), nt = m_triangles.size(), ne = m_edges.size();
+    const auto at = [](const std::vector<int>& map, int i) { return map[static_cast<size_t>(i)]; };
+
+    // Vertices by the Morton code of their position quantized to 21 bits per axis.
+    Eigen::AlignedBox3d box;
+    for (const Vec3& p : m_positions)
+        box.extend(p);
+    const Vec3 scale = box.sizes().cwiseMax(1e-300).cwiseInverse() * 2097151.0;
+    std::vector<std::pair<std::uint64_t, int>> keys(nv);
+    for (size_t i = 0; i < nv; ++i) {
+        const Vec3 q = (m_positions[i] - box.min()).cwiseProduct(scale);
+        keys[i] = {morton_code(static_cast<std::uint64_t>(q.x()), static_cast<std::uint64_t>(q.y()),
+                               static_cast<std::uint64_t>(q.z())),
+                   static_cast<int>(i)};
+    }
+    Renumbering vr = renumbering_by(keys);
+    // Triangles by their smallest new vertex, edges by their new vertex pair (ties: old order).
+    keys.resize(nt);
+    for (size_t t = 0; t < nt; ++t) {
+        const Triangle& tri = m_triangles[t];
+        const int lo = std::min({at(vr.map, tri[0]), at(vr.map, tri[1]), at(vr.map, tri[2])});
+        keys[t] = {static_cast<std::uint64_t>(lo) << 32 | t, static_cast<int>(t)};
+    }
+    const Renumbering tr = renumbering_by(keys);
+    keys.resize(ne);
+    for (size_t e = 0; e < ne; ++e) {
+        const int a = at(vr.map, m_edges[e][0]), b = at(vr.map, m_edges[e][1]);
+        keys[e] = {static_cast<std::uint64_t>(std::min(a, b)) << 32 |
+                       static_cast<std::uint32_t>(std::max(a, b)),
+                   static_cast<int>(e)};
+    }
+    const Renumbering er = renumbering_by(keys);
+
+    // Every record gathered into its new slot with its references renumbered (`moved` holds
+    // the old index of each new slot).
+    std::vector<Vec3> positions(nv);
+    std::vector<std::uint8_t> vertex_marked(nv);
+    std::vector<std::vector<int>> vertex_triangles(nv), vertex_edges(nv);
+    for (size_t n = 0; n < nv; ++n) {
+        const size_t old = static_cast<size_t>(vr.moved[n]);
+        positions[n] = m_positions[old];
+        vertex_marked[n] = m_vertex_marked[old];
+        vertex_triangles[n] = std::move(m_vertex_triangles[old]);
+        vertex_edges[n] = std::move(m_vertex_edges[old]);
+        remap_list(vertex_triangles[n], tr.map);
+        remap_list(vertex_edges[n], er.map);
+    }
+    m_positions = std::move(positions);
+    m_vertex_marked = std::move(vertex_marked);
+    m_vertex_triangles = std::move(vertex_triangles);
+    m_vertex_edges = std::move(vertex_edges);
+
+    std::vector<Triangle> triangles(nt);
+    std::vector<std::array<int, 3>> triangle_edges(nt);
+    std::vector<LabelPair> labels(nt);
+    std::vector<std::uint8_t> triangle_marked(nt);
+    for (size_t n = 0; n < nt; ++n) {
+        const size_t old = static_cast<size_t>(tr.moved[n]);
         for (size_t k = 0; k < 3; ++k) {
-            m_triangles[n][k] = vertex_map[static_cast<size_t>(t[k])];
-            m_triangle_edges[n][k] = edge_map[static_cast<size_t>(e[k])];
+            triangles[n][k] = at(vr.map, m_triangles[old][k]);
+            triangle_edges[n][k] = at(er.map, m_triangle_edges[old][k]);
         }
-        m_labels[n] = m_labels[ti];
-        m_triangle_marked[n] = m_triangle_marked[ti];
+        labels[n] = m_labels[old];
+        triangle_marked[n] = m_triangle_marked[old];
     }
-    m_triangles.resize(static_cast<size_t>(nt));
-    m_triangle_edges.resize(static_cast<size_t>(nt));
-    m_labels.resize(static_cast<size_t>(nt));
-    m_triangle_marked.resize(static_cast<size_t>(nt));
+    m_triangles = std::move(triangles);
+    m_triangle_edges = std::move(triangle_edges);
+    m_labels = std::move(labels);
+    m_triangle_marked = std::move(triangle_marked);
 
-    // Edges: new order is first appearance, not old order, so permute through scratch.
-    std::vector<Edge> edges(static_cast<size_t>(ne));
-    std::vector<std::vector<int>> edge_triangles(static_cast<size_t>(ne));
-    for (size_t ei = 0; ei < edge_map.size(); ++ei) {
-        const int now = edge_map[ei];
-        if (now == INVALID_INDEX)
-            continue;
-        const size_t n = static_cast<size_t>(now);
-        edges[n] = {vertex_map[static_cast<size_t>(m_edges[ei][0])],
-                    vertex_map[static_cast<size_t>(m_edges[ei][1])]};
-        edge_triangles[n] = std::move(m_edge_triangles[ei]);
+    std::vector<Edge> edges(ne);
+    std::vector<std::vector<int>> edge_triangles(ne);
+    for (size_t n = 0; n < ne; ++n) {
+        const size_t old = static_cast<size_t>(er.moved[n]);
+        const int a = at(vr.map, m_edges[old][0]), b = at(vr.map, m_edges[old][1]);
+        edges[n] = {std::min(a, b), std::max(a, b)};
+        edge_triangles[n] = std::move(m_edge_triangles[old]);
+        remap_list(edge_triangles[n], tr.map);
     }
-    tbb::parallel_for(0, ne, [&](int ei) {
-        remap_sorted(edge_triangles[static_cast<size_t>(ei)], triangle_map);
-    });
     m_edges = std::move(edges);
     m_edge_triangles = std::move(edge_triangles);
 
     for (MeshObserver* o : m_observers)
-        o->on_compact(vertex_map);
-    return vertex_map;
+        o->on_compact(vr.map);
+    return std::move(vr.map);
 }
 
 void SurfaceMesh::add_observer(MeshObserver* observer) {

@@ -10,6 +10,15 @@
 
 namespace meniscus::tracker {
 
+namespace {
+
+/// change_topology() renumbers the mesh spatially (SurfaceMesh::sort_spatially) when more than
+/// this fraction of its edges join far-apart indices (SurfaceMesh::far_edge_fraction): about
+/// 0.07–0.14 right after a renumbering, 0.6–0.8 for a mesher's order or a long run's.
+constexpr double REORDER_FAR_EDGE_FRACTION = 0.2;
+
+}  // namespace
+
 void TrackerOptions::validate() const {
     if (!(proximity_fraction > 0.0) || !std::isfinite(proximity_fraction))
         throw std::invalid_argument("proximity_fraction: expected a number > 0");
@@ -74,6 +83,12 @@ TopologyReport SurfaceTracker::change_topology() {
     }
     if (m_mesh.has_dead_elements())
         m_mesh.compact();
+    // compact() fills dead slots with the last elements, which scatters neighbours over memory
+    // step by step; renumbering along a space-filling curve once they are scattered enough keeps
+    // every pass over the mesh cache-friendly (profile_a1 at xi = 0.02: 14 renumberings in 400
+    // steps, the whole tracker step 13 % faster than with order-preserving compaction).
+    if (m_mesh.far_edge_fraction() > REORDER_FAR_EDGE_FRACTION)
+        m_mesh.sort_spatially();
     return report;
 }
 

@@ -63,8 +63,9 @@ public:
     /// Mesh improvement of one step (paper §3.5, §3.6.1): an empty report when improve_mesh is
     /// off. Leaves dead slots; call compact() (or change_topology(), which compacts) after.
     ImproveReport improve();
-    /// Topology changes of one step (§3.6, §3.7) when allowed, then compact(): vertex indices
-    /// may change (observers registered on mesh() are told).
+    /// Topology changes of one step (§3.6, §3.7) when allowed, then compact(), and a spatial
+    /// renumbering (SurfaceMesh::sort_spatially) when neighbours have drifted apart in memory:
+    /// vertex indices may change (observers registered on mesh() are told).
     TopologyReport change_topology();
     /// Removes dead slots (see SurfaceMesh::compact).
     void compact() { m_mesh.compact(); }

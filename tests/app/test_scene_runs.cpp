@@ -412,8 +412,11 @@ TEST(FlowScenes, ThinSheetSizingGainsLessVolumeUnderCurlNoise) {
     // A4's three-octave field to t = 12, when the sphere has been drawn into folded sheets: the
     // discretized sides of sheets thinner than their chord sag meet and collision handling holds
     // them apart, which adds volume; thin-sheet sizing refines there. Measured: +0.34 % on 7868
-    // triangles uniform, +0.09 % on 11000 sized. (The paper-like one-octave field folds later:
-    // collision handling has added under 0.001 % by t = 12, too little to compare.)
+    // triangles uniform, +0.09 % on 11000 sized with order-preserving compaction; +0.15 % on 7872
+    // and +0.02 % on 11086 since the mesh is renumbered spatially (the folding is chaotic: the
+    // order in which the remesher visits edges changes the numbers, not the ratio). (The
+    // paper-like one-octave field folds later: collision handling has added under 0.001 % by
+    // t = 12, too little to compare.)
     const auto volume_change = [](const char* name, int& triangles, double& by_collisions) {
         const std::vector<nlohmann::json> stats = flow_scene_stats(name, 12);
         triangles = stats.back()["triangles"].get<int>();
@@ -442,7 +445,7 @@ TEST(FlowScenes, ThinSheetSizingGainsLessVolumeUnderCurlNoise) {
               << " % on " << sized_triangles << " with thin-sheet sizing; by collision handling "
               << 100.0 * uniform_by_collisions << " % and " << 100.0 * sized_by_collisions
               << " %\n";
-    EXPECT_GT(uniform, 0.002);
+    EXPECT_GT(uniform, 0.001);
     EXPECT_LT(std::abs(sized), 0.5 * uniform);
     // Collision handling's share: measured +0.12 % uniform by t = 12.
     EXPECT_GT(uniform_by_collisions, 0.0005);

@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
 
 namespace meniscus::tracker {
 namespace {
@@ -20,6 +23,50 @@ SurfaceMesh octahedron() {
     return SurfaceMesh(
         {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
         {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
+}
+
+/// A latitude–longitude sphere (`rings` − 1 rings of `segments` vertices and the two poles) with
+/// its vertices and triangles numbered in a shuffled order, as a long run leaves them.
+SurfaceMesh shuffled_uv_sphere(int rings, int segments) {
+    std::vector<Vec3> positions = {{0, 0, 1}};
+    for (int r = 1; r < rings; ++r)
+        for (int s = 0; s < segments; ++s) {
+            const double theta = M_PI * r / rings, phi = 2 * M_PI * s / segments;
+            positions.emplace_back(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                   std::cos(theta));
+        }
+    positions.emplace_back(0, 0, -1);
+    const int south = static_cast<int>(positions.size()) - 1;
+    const auto ring = [&](int r, int s) { return 1 + (r - 1) * segments + s % segments; };
+    std::vector<Triangle> triangles;
+    for (int s = 0; s < segments; ++s) {
+        triangles.push_back({0, ring(1, s), ring(1, s + 1)});
+        triangles.push_back({south, ring(rings - 1, s + 1), ring(rings - 1, s)});
+        for (int r = 1; r + 1 < rings; ++r) {
+            triangles.push_back({ring(r, s), ring(r + 1, s), ring(r + 1, s + 1)});
+            triangles.push_back({ring(r, s), ring(r + 1, s + 1), ring(r, s + 1)});
+        }
+    }
+    std::mt19937 random(7);
+    std::vector<int> order(positions.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), random);
+    std::vector<Vec3> shuffled(positions.size());
+    for (size_t i = 0; i < order.size(); ++i)
+        shuffled[static_cast<size_t>(order[i])] = positions[i];
+    for (Triangle& t : triangles)
+        for (int& v : t)
+            v = order[static_cast<size_t>(v)];
+    std::shuffle(triangles.begin(), triangles.end(), random);
+    return SurfaceMesh(shuffled, triangles);
+}
+
+/// Triangle t with its vertices renamed through `map` and rotated to start at the smallest.
+Triangle renamed(const Triangle& t, const std::vector<int>& map) {
+    Triangle r = {map[static_cast<size_t>(t[0])], map[static_cast<size_t>(t[1])],
+                  map[static_cast<size_t>(t[2])]};
+    std::rotate(r.begin(), std::min_element(r.begin(), r.end()), r.end());
+    return r;
 }
 
 bool has_kind(const std::vector<MeshViolation>& v, ViolationKind kind) {
@@ -110,12 +157,12 @@ TEST(SurfaceMesh, CollapseAndCompactNotifyObservers) {
     EXPECT_TRUE(validate_mesh(m).empty());
 }
 
-TEST(SurfaceMesh, CompactEqualsRebuildingFromTheLiveElements) {
-    // compact() renumbers in place; what it leaves must be exactly the mesh that the
-    // constructor builds from the live positions, triangles and labels (edge numbering,
-    // adjacency order and all), so that every later operation behaves as it did when compact()
-    // was that rebuild. The octahedron is split, flipped and collapsed into a mesh with dead
-    // vertices, triangles and edges and unsorted adjacency lists (removals swap with the back).
+TEST(SurfaceMesh, CompactMovesOnlyTheElementsAboveTheLiveCount) {
+    // compact() keeps every element below its kind's live count where it is and moves the live
+    // ones above it into the dead slots below it, lowest first; what it leaves must be the same
+    // mesh renumbered that way, every adjacency list complete and in its old order. The octahedron
+    // is split, flipped and collapsed into a mesh with dead vertices, triangles and edges and
+    // unsorted adjacency lists (removals swap with the back).
     SurfaceMesh m = octahedron();
     for (int round = 0; round < 6; ++round) {
         for (int ei = 0, n = m.num_edges(); ei < n; ei += 3)
@@ -154,46 +201,132 @@ TEST(SurfaceMesh, CompactEqualsRebuildingFromTheLiveElements) {
     ValidationOptions connectivity_only;  // the positions are not the point here
     connectivity_only.check_degenerate_area = false;
     ASSERT_TRUE(validate_mesh(m, connectivity_only).empty());
-    std::vector<Vec3> positions;
-    for (int vi = 0; vi < m.num_vertices(); ++vi)
-        if (m.vertex_alive(vi))
-            positions.push_back(m.position(vi));
-    std::vector<int> map(static_cast<size_t>(m.num_vertices()), INVALID_INDEX);
-    for (int vi = 0, next = 0; vi < m.num_vertices(); ++vi)
-        if (m.vertex_alive(vi))
-            map[static_cast<size_t>(vi)] = next++;
-    std::vector<Triangle> triangles;
-    std::vector<LabelPair> labels;
-    for (int ti = 0; ti < m.num_triangles(); ++ti)
-        if (m.triangle_alive(ti)) {
-            Triangle t = m.triangle(ti);
-            for (int& v : t)
-                v = map[static_cast<size_t>(v)];
-            triangles.push_back(t);
-            labels.push_back(m.labels(ti));
+
+    // The renumbering the rule gives, for one kind of element.
+    const auto expected_map = [](int slots, const auto& alive) {
+        std::vector<int> map(static_cast<size_t>(slots), INVALID_INDEX);
+        int live = 0;
+        for (int i = 0; i < slots; ++i)
+            live += alive(i) ? 1 : 0;
+        int hole = 0;
+        for (int i = 0; i < slots; ++i) {
+            if (!alive(i))
+                continue;
+            if (i < live) {
+                map[static_cast<size_t>(i)] = i;
+                continue;
+            }
+            while (hole < live && alive(hole))
+                ++hole;
+            map[static_cast<size_t>(i)] = hole++;
         }
-    const SurfaceMesh rebuilt(positions, triangles, labels);
-    EXPECT_EQ(m.compact(), map);
-    ASSERT_EQ(m.num_vertices(), rebuilt.num_vertices());
-    ASSERT_EQ(m.num_triangles(), rebuilt.num_triangles());
-    ASSERT_EQ(m.num_edges(), rebuilt.num_edges());
+        return map;
+    };
+    const std::vector<int> vmap =
+        expected_map(m.num_vertices(), [&](int i) { return m.vertex_alive(i); });
+    const std::vector<int> tmap =
+        expected_map(m.num_triangles(), [&](int i) { return m.triangle_alive(i); });
+    const std::vector<int> emap =
+        expected_map(m.num_edges(), [&](int i) { return m.edge_alive(i); });
+    const auto mapped = [](std::vector<int> list, const std::vector<int>& map) {
+        for (int& i : list)
+            i = map[static_cast<size_t>(i)];
+        return list;
+    };
+    const SurfaceMesh before = m;
+
+    EXPECT_EQ(m.compact(), vmap);
     EXPECT_FALSE(m.has_dead_elements());
-    for (int vi = 0; vi < m.num_vertices(); ++vi) {
-        EXPECT_EQ(m.position(vi), rebuilt.position(vi));
-        EXPECT_EQ(m.vertex_triangles(vi), rebuilt.vertex_triangles(vi)) << "vertex " << vi;
-        EXPECT_EQ(m.vertex_edges(vi), rebuilt.vertex_edges(vi)) << "vertex " << vi;
-    }
-    for (int ti = 0; ti < m.num_triangles(); ++ti) {
-        EXPECT_EQ(m.triangle(ti), rebuilt.triangle(ti));
-        EXPECT_EQ(m.triangle_edges(ti), rebuilt.triangle_edges(ti));
-        EXPECT_EQ(m.labels(ti).inside, rebuilt.labels(ti).inside);
-        EXPECT_EQ(m.labels(ti).outside, rebuilt.labels(ti).outside);
-    }
-    for (int ei = 0; ei < m.num_edges(); ++ei) {
-        EXPECT_EQ(m.edge(ei), rebuilt.edge(ei));
-        EXPECT_EQ(m.edge_triangles(ei), rebuilt.edge_triangles(ei)) << "edge " << ei;
-    }
     EXPECT_TRUE(validate_mesh(m, connectivity_only).empty());
+    ASSERT_EQ(m.num_vertices(), before.count_live_vertices());
+    ASSERT_EQ(m.num_triangles(), before.count_live_triangles());
+    ASSERT_EQ(m.num_edges(), before.count_live_edges());
+    for (int vi = 0; vi < before.num_vertices(); ++vi) {
+        if (!before.vertex_alive(vi))
+            continue;
+        const int now = vmap[static_cast<size_t>(vi)];
+        EXPECT_EQ(m.position(now), before.position(vi));
+        EXPECT_EQ(m.vertex_triangles(now), mapped(before.vertex_triangles(vi), tmap)) << vi;
+        EXPECT_EQ(m.vertex_edges(now), mapped(before.vertex_edges(vi), emap)) << vi;
+    }
+    for (int ti = 0; ti < before.num_triangles(); ++ti) {
+        if (!before.triangle_alive(ti))
+            continue;
+        const int now = tmap[static_cast<size_t>(ti)];
+        const Triangle& t = before.triangle(ti);
+        EXPECT_EQ(m.triangle(now),
+                  (Triangle{vmap[static_cast<size_t>(t[0])], vmap[static_cast<size_t>(t[1])],
+                            vmap[static_cast<size_t>(t[2])]}));
+        const std::array<int, 3>& e = before.triangle_edges(ti);
+        EXPECT_EQ(m.triangle_edges(now), (std::array<int, 3>{emap[static_cast<size_t>(e[0])],
+                                                             emap[static_cast<size_t>(e[1])],
+                                                             emap[static_cast<size_t>(e[2])]}));
+        EXPECT_EQ(m.labels(now), before.labels(ti));
+    }
+    for (int ei = 0; ei < before.num_edges(); ++ei) {
+        if (!before.edge_alive(ei))
+            continue;
+        const int now = emap[static_cast<size_t>(ei)];
+        const Edge& e = before.edge(ei);
+        const int a = vmap[static_cast<size_t>(e[0])], b = vmap[static_cast<size_t>(e[1])];
+        EXPECT_EQ(m.edge(now), (Edge{std::min(a, b), std::max(a, b)}));  // smaller index first
+        EXPECT_EQ(m.edge_triangles(now), mapped(before.edge_triangles(ei), tmap)) << ei;
+    }
+}
+
+TEST(SurfaceMesh, SortSpatiallyKeepsTheMeshAndBringsNeighboursTogether) {
+    struct Recorder : MeshObserver {
+        std::vector<int> map;
+        void on_compact(const std::vector<int>& m) override { map = m; }
+    } recorder;
+    SurfaceMesh m = shuffled_uv_sphere(40, 80);  // 3122 vertices
+    const SurfaceMesh before = m;
+    EXPECT_GT(before.far_edge_fraction(), 0.5);
+    m.add_observer(&recorder);
+    const std::vector<int> map = m.sort_spatially();
+    EXPECT_EQ(recorder.map, map);
+    EXPECT_LT(m.far_edge_fraction(), 0.2);
+
+    // The same mesh, renamed: a permutation that carries positions, triangles (orientation and
+    // labels) and edges along, with consistent adjacency.
+    ASSERT_EQ(map.size(), static_cast<size_t>(before.num_vertices()));
+    std::vector<int> sorted_map = map;
+    std::sort(sorted_map.begin(), sorted_map.end());
+    std::vector<int> identity(map.size());
+    std::iota(identity.begin(), identity.end(), 0);
+    EXPECT_EQ(sorted_map, identity);
+    for (int vi = 0; vi < before.num_vertices(); ++vi)
+        EXPECT_EQ(m.position(map[static_cast<size_t>(vi)]), before.position(vi));
+    std::vector<Triangle> expected, got;
+    for (int ti = 0; ti < before.num_triangles(); ++ti)
+        expected.push_back(renamed(before.triangle(ti), map));
+    std::vector<int> all(map.size());
+    std::iota(all.begin(), all.end(), 0);
+    int previous_lowest = 0;
+    for (int ti = 0; ti < m.num_triangles(); ++ti) {
+        got.push_back(renamed(m.triangle(ti), all));
+        const int lowest = got.back()[0];
+        EXPECT_LE(previous_lowest, lowest) << ti;  // triangles follow their smallest vertex
+        previous_lowest = lowest;
+    }
+    std::sort(expected.begin(), expected.end());
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, expected);
+    std::vector<int> old_of(map.size());
+    for (size_t vi = 0; vi < map.size(); ++vi)
+        old_of[static_cast<size_t>(map[vi])] = static_cast<int>(vi);
+    ASSERT_EQ(m.num_edges(), before.num_edges());
+    for (int ei = 0; ei < m.num_edges(); ++ei) {
+        const Edge& e = m.edge(ei);
+        EXPECT_LT(e[0], e[1]);  // smaller index first
+        EXPECT_NE(
+            before.find_edge(old_of[static_cast<size_t>(e[0])], old_of[static_cast<size_t>(e[1])]),
+            INVALID_INDEX);
+    }
+    EXPECT_TRUE(validate_mesh(m).empty());
+
+    m.remove_triangle(0);
+    EXPECT_THROW(m.sort_spatially(), std::logic_error);
 }
 
 TEST(SurfaceMesh, DuplicateVertexSeparatesFans) {
@@ -236,8 +369,13 @@ TEST(SurfaceMesh, MarksFollowConnectivityChangesAndCompaction) {
     for (int vi = 0; vi < 6; ++vi)
         EXPECT_EQ(m.vertex_marked(vertex_map[static_cast<size_t>(vi)]),
                   vi == 0 || vi == 2 || vi == 4 || vi == 5);
-    for (int ti = 0; ti < m.num_triangles(); ++ti)
-        EXPECT_EQ(m.triangle_marked(ti), ti >= 6) << ti;  // the flip's two, last in order
+    const int a = vertex_map[4], b = vertex_map[5];
+    for (int ti = 0; ti < m.num_triangles(); ++ti) {  // the flip's two: the ones on edge (4, 5)
+        const Triangle& t = m.triangle(ti);
+        const bool on_new_edge =
+            std::count(t.begin(), t.end(), a) + std::count(t.begin(), t.end(), b) == 2;
+        EXPECT_EQ(m.triangle_marked(ti), on_new_edge) << ti;
+    }
 
     // A duplicated vertex and its new triangles are marked.
     m.clear_triangle_marks();
