@@ -72,6 +72,19 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
         enum_field(r, "y_max", o.walls.y_max, WALL_TYPES, "wall at max y");
         enum_field(r, "z_min", o.walls.z_min, WALL_TYPES, "wall at min z");
         enum_field(r, "z_max", o.walls.z_max, WALL_TYPES, "wall at max z");
+        // A no-slip wall may slide along itself (a moving wall: shear flows, a drop in shear).
+        r.vec3("x_min_velocity", o.walls.x_min_velocity, Range::any(), "m/s",
+               "velocity of the x_min wall along itself (x component 0; no_slip walls only)");
+        r.vec3("x_max_velocity", o.walls.x_max_velocity, Range::any(), "m/s",
+               "velocity of the x_max wall along itself (x component 0; no_slip walls only)");
+        r.vec3("y_min_velocity", o.walls.y_min_velocity, Range::any(), "m/s",
+               "velocity of the y_min wall along itself (y component 0; no_slip walls only)");
+        r.vec3("y_max_velocity", o.walls.y_max_velocity, Range::any(), "m/s",
+               "velocity of the y_max wall along itself (y component 0; no_slip walls only)");
+        r.vec3("z_min_velocity", o.walls.z_min_velocity, Range::any(), "m/s",
+               "velocity of the z_min wall along itself (z component 0; no_slip walls only)");
+        r.vec3("z_max_velocity", o.walls.z_max_velocity, Range::any(), "m/s",
+               "velocity of the z_max wall along itself (z component 0; no_slip walls only)");
     });
     enum_field(v, "advection", o.advection.scheme,
                {{"maccormack", fluid::AdvectionScheme::maccormack},

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 #include "fluid/extrapolation.h"
 #include "fluid/forces.h"
@@ -53,7 +54,11 @@ void FluidOptions::validate() const {
     if (!gravity.allFinite()) {
         throw std::invalid_argument("FluidOptions.gravity must be finite (m/s^2)");
     }
-    walls.validate();
+    try {
+        walls.validate();
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("walls/") + e.what());
+    }
     advection.validate();
     viscosity.validate();
     pressure.validate();
@@ -208,6 +213,8 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
         std::vector<double> z, q;
         Array3<double> direction;
         MacGrid impulse(1, 1, 1, dx);
+        // The impulses are velocity increments: homogeneous, so moving walls stand still for them.
+        const WallOptions walls_at_rest = m_options.walls.at_rest();
         double rz = 0.0;
         if (!result.converged_passes) {
             clock.lap_into(result.timings.pressure_solve);
@@ -231,7 +238,7 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
             apply_pressure_gradient(impulse, interface, increment_phases, mode, dt,
                                     m_options.pressure, direction);
             add_solve(result.viscosity,
-                      m_viscosity.solve(impulse, interface, phases, mode, m_options.walls, dt,
+                      m_viscosity.solve(impulse, interface, phases, mode, walls_at_rest, dt,
                                         m_options.viscosity,
                                         m_options.pressure.min_liquid_fraction));
             clock.lap_into(result.timings.viscosity);

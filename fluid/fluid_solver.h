@@ -4,7 +4,8 @@
 ///
 /// The solver never sees the interface mesh: each step receives an InterfaceInput (φ at cell
 /// centres, negative in the liquid; κ on the faces it crosses; see interface_input.h). All
-/// quantities are SI. The box is closed: the normal velocity on every wall is zero.
+/// quantities are SI. The box is closed: the normal velocity on every wall is zero; no-slip walls
+/// may slide along themselves (WallOptions' velocities).
 
 #include <Eigen/Core>
 

@@ -26,7 +26,7 @@ void split_coordinate(double s, int n, int& base, double& fraction) {
 
 void check_wall(WallType type, const char* name) {
     if (type != WallType::free_slip && type != WallType::no_slip) {
-        throw std::invalid_argument(std::string("WallOptions.") + name +
+        throw std::invalid_argument(std::string(name) +
                                     ": unknown wall type (use free_slip or no_slip)");
     }
 }
@@ -49,6 +49,36 @@ WallType WallOptions::at(int axis, int side) const {
     }
 }
 
+const Eigen::Vector3d& WallOptions::velocity_at(int axis, int side) const {
+    if (side != 0 && side != 1)
+        throw std::invalid_argument("WallOptions::velocity_at: side must be 0 (min) or 1 (max)");
+    switch (axis) {
+        case 0:
+            return side == 0 ? x_min_velocity : x_max_velocity;
+        case 1:
+            return side == 0 ? y_min_velocity : y_max_velocity;
+        case 2:
+            return side == 0 ? z_min_velocity : z_max_velocity;
+        default:
+            throw std::invalid_argument("WallOptions::velocity_at: axis must be 0, 1 or 2");
+    }
+}
+
+bool WallOptions::moving() const {
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side)
+            if (velocity_at(axis, side) != Eigen::Vector3d::Zero())
+                return true;
+    return false;
+}
+
+WallOptions WallOptions::at_rest() const {
+    WallOptions walls = *this;
+    walls.x_min_velocity = walls.x_max_velocity = walls.y_min_velocity = walls.y_max_velocity =
+        walls.z_min_velocity = walls.z_max_velocity = Eigen::Vector3d::Zero();
+    return walls;
+}
+
 WallOptions WallOptions::all(WallType type) {
     WallOptions walls;
     walls.x_min = walls.x_max = walls.y_min = walls.y_max = walls.z_min = walls.z_max = type;
@@ -62,6 +92,25 @@ void WallOptions::validate() const {
     check_wall(y_max, "y_max");
     check_wall(z_min, "z_min");
     check_wall(z_max, "z_max");
+    static const char* const names[3][2] = {
+        {"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side) {
+            const Eigen::Vector3d& u = velocity_at(axis, side);
+            const std::string field = std::string(names[axis][side]) + "_velocity";
+            if (!u.allFinite())
+                throw std::invalid_argument(field + ": expected finite numbers (m/s)");
+            if (u[axis] != 0.0)
+                throw std::invalid_argument(
+                    field +
+                    ": the component along the wall's normal must be 0 (a wall slides "
+                    "along itself; fluid through a face is an inflow, not a wall)");
+            if (u != Eigen::Vector3d::Zero() && at(axis, side) != WallType::no_slip)
+                throw std::invalid_argument(field +
+                                            ": a free-slip wall exerts no shear, so it "
+                                            "cannot drag the fluid; make " +
+                                            names[axis][side] + " no_slip");
+        }
 }
 
 Eigen::Vector3d field_offset(FieldLocation location) {

@@ -28,7 +28,8 @@ enum class WallType {
     no_slip     ///< tangential velocity is zero on the wall
 };
 
-/// Wall type of each of the six box walls.
+/// Wall type of each of the six box walls, and the velocity of each no-slip wall sliding along
+/// itself (a moving wall: the fluid next to it is dragged at that velocity).
 struct WallOptions {
     WallType x_min = WallType::free_slip;
     WallType x_max = WallType::free_slip;
@@ -36,12 +37,27 @@ struct WallOptions {
     WallType y_max = WallType::free_slip;
     WallType z_min = WallType::free_slip;
     WallType z_max = WallType::free_slip;
+    /// Tangential velocity of each wall (m/s); the component along the wall's normal must be 0,
+    /// and only a no-slip wall may move.
+    Eigen::Vector3d x_min_velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d x_max_velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d y_min_velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d y_max_velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d z_min_velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d z_max_velocity = Eigen::Vector3d::Zero();
 
     /// Wall on `axis` (0..2) at `side` (0 = min, 1 = max). Throws std::invalid_argument otherwise.
     WallType at(int axis, int side) const;
-    /// All six walls set to `type`.
+    /// Velocity of the wall on `axis` at `side` (m/s). Throws std::invalid_argument like at().
+    const Eigen::Vector3d& velocity_at(int axis, int side) const;
+    /// True if any wall moves.
+    bool moving() const;
+    /// The same walls, every one at rest (for the homogeneous solves of velocity increments).
+    WallOptions at_rest() const;
+    /// All six walls set to `type`, at rest.
     static WallOptions all(WallType type);
-    /// Throws std::invalid_argument naming the field if an enum holds an unknown value.
+    /// Throws std::invalid_argument naming the field if an enum holds an unknown value, or a
+    /// velocity is not finite, has a normal component, or belongs to a free-slip wall.
     void validate() const;
 };
 

@@ -93,11 +93,14 @@ public:
         }
     }
 
-    /// y = K x on every interior face (entries on wall-normal faces are left unspecified).
-    void stiffness(const std::vector<double>& x, std::vector<double>& y) const {
+    /// y = K x on every interior face (entries on wall-normal faces are left unspecified). With
+    /// `moving` walls the shear strain next to a no-slip wall is taken relative to the wall's
+    /// velocity, which makes the map affine: use it only for the right-hand side.
+    void stiffness(const std::vector<double>& x, std::vector<double>& y,
+                   const WallOptions* moving = nullptr) const {
         y.resize(m_size);
         normal_stresses(x);
-        shear_stresses(x);
+        shear_stresses(x, moving);
         stress_divergence(y);
         if (m_surface)
             m_surface->add_stiffness(m_surface_scale, x, y);
@@ -352,12 +355,20 @@ private:
     }
 
     /// τ(edge) = 2Δt W_e (∂_b x_a + ∂_a x_b) on edges parallel to c, (a, b) the other axes; ∂
-    /// one-sided at walls, where a no-slip wall mirrors the tangential velocity, with the face indices
-    /// stepped along each row instead of recomputed.
-    void shear_stresses(const std::vector<double>& x) const {
+    /// one-sided at walls, where a no-slip wall mirrors the tangential velocity relative to the
+    /// wall's own (`moving`, else at rest), with the face indices stepped along each row instead
+    /// of recomputed.
+    void shear_stresses(const std::vector<double>& x, const WallOptions* moving) const {
         for (int c = 0; c < 3; ++c) {
             const int a = (c + 1) % 3;
             const int b = (c + 2) % 3;
+            // The walls' velocity components along the derivative's numerator: x_a at the b
+            // walls, x_b at the a walls.
+            const auto wall = [&](int axis, int side, int component) {
+                return moving ? moving->velocity_at(axis, side)[component] : 0.0;
+            };
+            const double a_lo = wall(b, 0, a), a_hi = wall(b, 1, a);
+            const double b_lo = wall(a, 0, b), b_hi = wall(a, 1, b);
             const Array3<double>& weight = m_edge_weight[c];
             Array3<double>& tau = m_shear_stress[c];
             const std::size_t step_a = face_stride(a, b);  // x_a along b
@@ -383,13 +394,15 @@ private:
                                 const std::size_t fa = row_a + i;
                                 const std::size_t fb = row_b + i;
                                 const double d_ab =
-                                    e[b] == 0     ? MIRROR_FACTOR * x[fa] / m_dx
-                                    : e[b] == n_b ? -MIRROR_FACTOR * x[fa - step_a] / m_dx
-                                                  : (x[fa] - x[fa - step_a]) / m_dx;
+                                    e[b] == 0 ? MIRROR_FACTOR * (x[fa] - a_lo) / m_dx
+                                    : e[b] == n_b
+                                        ? -MIRROR_FACTOR * (x[fa - step_a] - a_hi) / m_dx
+                                        : (x[fa] - x[fa - step_a]) / m_dx;
                                 const double d_ba =
-                                    e[a] == 0     ? MIRROR_FACTOR * x[fb] / m_dx
-                                    : e[a] == n_a ? -MIRROR_FACTOR * x[fb - step_b] / m_dx
-                                                  : (x[fb] - x[fb - step_b]) / m_dx;
+                                    e[a] == 0 ? MIRROR_FACTOR * (x[fb] - b_lo) / m_dx
+                                    : e[a] == n_a
+                                        ? -MIRROR_FACTOR * (x[fb - step_b] - b_hi) / m_dx
+                                        : (x[fb] - x[fb - step_b]) / m_dx;
                                 tau[edge_row + i] = 2.0 * m_dt * w * (d_ab + d_ba);
                             }
                         }
@@ -587,14 +600,15 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     std::vector<double>& x = ws.x;
     std::vector<double>& fixed = ws.fixed;
     std::vector<double>& b = ws.b;
-    // Split u* into the unknowns x (initial guess) and the fixed faces; b = ρ u* − K u_fixed.
+    // Split u* into the unknowns x (initial guess) and the fixed faces; b = ρ u* − K u_fixed,
+    // K's wall strains relative to moving walls.
     op.gather(grid, ws.u_star);
     x.assign(n, 0.0);
     fixed.assign(n, 0.0);
     for (std::size_t f = 0; f < n; ++f) {
         (unknown[f] ? x[f] : fixed[f]) = ws.u_star[f];
     }
-    op.stiffness(fixed, b);
+    op.stiffness(fixed, b, walls.moving() ? &walls : nullptr);
     for (std::size_t f = 0; f < n; ++f) {
         b[f] = unknown[f] ? density[f] * ws.u_star[f] - b[f] : 0.0;
     }
