@@ -223,20 +223,48 @@ void BM_ChangeTopologyQuiet(benchmark::State& state) {
     state.counters["separate_s"] = report.separation.seconds;
 }
 
-/// SurfaceMesh::compact() after a tenth of the edges were split (dead slots to remove).
-void BM_Compact(benchmark::State& state) {
-    SurfaceMesh base = sphere_mesh(static_cast<int>(state.range(0)), RADIUS, Vec3::Zero());
+/// A sphere mesh of about `triangles` triangles after a tenth of its edges were split (the
+/// split triangles are dead slots, the new ones appended).
+SurfaceMesh sphere_with_dead_slots(int triangles) {
+    SurfaceMesh base = sphere_mesh(triangles, RADIUS, Vec3::Zero());
     for (int ei = 0, n = base.num_edges(); ei < n; ei += 10)
         if (base.edge_alive(ei)) {
             const auto e = base.edge(ei);
             base.split_edge(ei, 0.5 * (base.position(e[0]) + base.position(e[1])));
         }
+    return base;
+}
+
+/// SurfaceMesh::compact() of sphere_with_dead_slots() (copying the mesh and freeing it are not
+/// timed: freeing its adjacency lists cost more than the compaction).
+void BM_Compact(benchmark::State& state) {
+    const SurfaceMesh base = sphere_with_dead_slots(static_cast<int>(state.range(0)));
     for (auto _ : state) {
         state.PauseTiming();
         SurfaceMesh mesh = base;
         state.ResumeTiming();
         mesh.compact();
         benchmark::DoNotOptimize(mesh);
+        state.PauseTiming();
+        { const SurfaceMesh gone = std::move(mesh); }
+        state.ResumeTiming();
+    }
+    state.counters["triangles"] = base.count_live_triangles();
+}
+
+/// SurfaceMesh::sort_spatially() of the compacted sphere_with_dead_slots() (not timed as above).
+void BM_SortSpatially(benchmark::State& state) {
+    SurfaceMesh base = sphere_with_dead_slots(static_cast<int>(state.range(0)));
+    base.compact();
+    for (auto _ : state) {
+        state.PauseTiming();
+        SurfaceMesh mesh = base;
+        state.ResumeTiming();
+        mesh.sort_spatially();
+        benchmark::DoNotOptimize(mesh);
+        state.PauseTiming();
+        { const SurfaceMesh gone = std::move(mesh); }
+        state.ResumeTiming();
     }
     state.counters["triangles"] = base.count_live_triangles();
 }
@@ -295,6 +323,7 @@ BENCHMARK(BM_ImproveMeshSteadyState)
 BENCHMARK(BM_ChangeTopology)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ChangeTopologyQuiet)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Compact)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SortSpatially)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ThinSheetSizing)->Arg(10000)->Arg(50000)->Arg(200000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
