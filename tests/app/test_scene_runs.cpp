@@ -151,8 +151,8 @@ TEST(ScenePhysics, DropInShearStretchesAlongTheExtensionalAxis) {
     // drop_shear: walls at y = 0 and 8 mm slide at ∓4 cm/s (G = 10 1/s), the 2 mm drop in the
     // middle. From rest the shear reaches the drop by diffusion and stretches it along the
     // extensional axis (45°), turning towards the flow as it deforms; the full run levels off
-    // at D = 0.132, 33.8° (the README's numbers). After 0.02 s (2 frames) measured: D = 0.050 at
-    // 42.6°. Without the moving walls nothing would move at all.
+    // at D = 0.191, 29.5° (the README's numbers). After 0.02 s (2 frames) measured: D = 0.053 at
+    // 42.5°. Without the moving walls nothing would move at all.
     Scene scene = load_scene(std::string(MENISCUS_SOURCE_DIR) + "/scenes/drop_shear.json");
     scene.tracker.verify_intersection_free = true;
     scene.output.vdb = false;
