@@ -86,14 +86,11 @@ WallOptions WallOptions::all(WallType type) {
 }
 
 void WallOptions::validate() const {
-    check_wall(x_min, "x_min");
-    check_wall(x_max, "x_max");
-    check_wall(y_min, "y_min");
-    check_wall(y_max, "y_max");
-    check_wall(z_min, "z_min");
-    check_wall(z_max, "z_max");
     static const char* const names[3][2] = {
         {"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side)
+            check_wall(at(axis, side), names[axis][side]);
     for (int axis = 0; axis < 3; ++axis)
         for (int side = 0; side < 2; ++side) {
             const Eigen::Vector3d& u = velocity_at(axis, side);
