@@ -8,6 +8,9 @@
 
 #include "tracker/collision_resolution.h"
 
+#include <cstdint>
+#include <vector>
+
 namespace meniscus::tracker {
 
 /// Mesh improvement: split, flip, collapse and null-space smoothing (§3.5, §3.6.1).
@@ -208,6 +211,14 @@ struct ImproveContext {
     CollisionOptions collision;
     /// Used to clean up after collapses and flips when topology changes are allowed.
     SeparationOptions separation;
+    /// Vertices that stay where they are (optional; indices past its end are free): smoothing
+    /// leaves them, and a collapse onto one keeps its position (as an open surface's boundary).
+    const std::vector<std::uint8_t>* pinned = nullptr;
+    /// Is vertex vi pinned?
+    bool is_pinned(int vi) const {
+        return pinned && static_cast<size_t>(vi) < pinned->size() &&
+               (*pinned)[static_cast<size_t>(vi)] != 0;
+    }
     /// Checked between operations: throws meniscus::Cancelled once requested (the mesh is then
     /// valid but only partly improved).
     CancellationToken cancel;

@@ -59,10 +59,11 @@ SurfaceTracker::SurfaceTracker(SurfaceMesh mesh, const TrackerOptions& options)
     m_options.collision.cancel = m_options.cancel;
 }
 
-ImproveReport SurfaceTracker::improve() {
+ImproveReport SurfaceTracker::improve(const std::vector<std::uint8_t>* pinned) {
     if (!m_options.improve_mesh)
         return {};
     ImproveContext context;
+    context.pinned = pinned;
     context.xi = m_xi;
     context.collision_safety = m_options.collision_safety;
     context.allow_topology_changes = m_options.allow_topology_changes;
@@ -92,7 +93,8 @@ TopologyReport SurfaceTracker::change_topology() {
     return report;
 }
 
-IntegrateResult SurfaceTracker::integrate(const std::vector<Vec3>& velocities, double dt) {
+IntegrateResult SurfaceTracker::integrate(const std::vector<Vec3>& velocities, double dt,
+                                          const std::vector<std::uint8_t>* pinned) {
     const auto start = std::chrono::steady_clock::now();
     if (velocities.size() != static_cast<size_t>(m_mesh.num_vertices()))
         throw std::invalid_argument(
@@ -100,14 +102,19 @@ IntegrateResult SurfaceTracker::integrate(const std::vector<Vec3>& velocities, d
             std::to_string(m_mesh.num_vertices()) + " vertex slots");
     if (!(dt > 0.0) || !std::isfinite(dt))
         throw std::invalid_argument("SurfaceTracker::integrate: dt must be a finite number > 0");
+    if (pinned && pinned->size() != velocities.size())
+        throw std::invalid_argument("SurfaceTracker::integrate: pinned must be sized num_vertices()");
     const std::vector<Vec3>& x0 = m_mesh.positions();
     std::vector<Vec3> x1(x0.size());
-    for (size_t i = 0; i < x0.size(); ++i)
-        x1[i] = m_mesh.vertex_alive(static_cast<int>(i)) ? Vec3(x0[i] + dt * velocities[i]) : x0[i];
+    for (size_t i = 0; i < x0.size(); ++i) {
+        const bool moves = m_mesh.vertex_alive(static_cast<int>(i)) && !(pinned && (*pinned)[i]);
+        x1[i] = moves ? Vec3(x0[i] + dt * velocities[i]) : x0[i];
+    }
 
     IntegrateResult result;
     if (m_options.collision_safety)
-        result.collisions = resolve_collisions(m_mesh, x0, x1, dt, m_options.collision);
+        result.collisions =
+            resolve_collisions(m_mesh, x0, x1, dt, m_options.collision, nullptr, pinned);
     result.time_advanced = dt * result.collisions.motion_fraction;
     m_mesh.set_positions(x1);
     if (m_options.verify_intersection_free)

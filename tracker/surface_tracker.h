@@ -9,6 +9,7 @@
 #include "tracker/remesh_options.h"
 #include "tracker/topology/change_topology.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace meniscus::tracker {
@@ -62,7 +63,9 @@ public:
 
     /// Mesh improvement of one step (paper §3.5, §3.6.1): an empty report when improve_mesh is
     /// off. Leaves dead slots; call compact() (or change_topology(), which compacts) after.
-    ImproveReport improve();
+    /// `pinned` (optional, indexed by vertex; vertices past its end are free): vertices that
+    /// smoothing and collapses leave where they are (ImproveContext::pinned).
+    ImproveReport improve(const std::vector<std::uint8_t>* pinned = nullptr);
     /// Topology changes of one step (§3.6, §3.7) when allowed, then compact(), and a spatial
     /// renumbering (SurfaceMesh::sort_spatially) when neighbours have drifted apart in memory:
     /// vertex indices may change (observers registered on mesh() are told).
@@ -72,8 +75,11 @@ public:
 
     /// Moves every live vertex by velocities[vi] · dt (velocities sized mesh().num_vertices()),
     /// changed as little as needed to keep the mesh intersection-free when collision safety is
-    /// on. Throws std::invalid_argument on size mismatch or dt ≤ 0.
-    IntegrateResult integrate(const std::vector<Vec3>& velocities, double dt);
+    /// on. `pinned` (optional, sized num_vertices()): vertices that do not move at all, whatever
+    /// their velocity (collision responses leave them where they are). Throws
+    /// std::invalid_argument on size mismatch or dt ≤ 0.
+    IntegrateResult integrate(const std::vector<Vec3>& velocities, double dt,
+                              const std::vector<std::uint8_t>* pinned = nullptr);
 
     /// Exact state for checkpoints: ξ and the mesh (SurfaceMesh::save_state). The options are
     /// the caller's (a resumed run builds the tracker from the same scene). load_state() throws

@@ -14,6 +14,7 @@
 #include "tracker/remesh/butterfly.h"
 #include "tracker/remesh/improve.h"
 #include "tracker/remesh/split.h"
+#include "tracker/surface_tracker.h"
 #include "tracker/topology/change_topology.h"
 
 #include <gtest/gtest.h>
@@ -420,6 +421,47 @@ TEST(Collapse, CoarseningCubesKeepsTheirCornersInPlace) {
             kept = kept || (cubes.vertex_alive(vi) && cubes.position(vi) == c);
         EXPECT_TRUE(kept) << "corner " << c.transpose() << " moved or vanished";
     }
+}
+
+TEST(PinnedVertices, NeitherMotionNorImprovementMovesThem) {
+    // The lower half of a sphere pinned (as a nozzle's mesh behind an inflow face): a swirling
+    // motion and a coarsening improvement move the upper half only; a pinned vertex may be
+    // collapsed away onto a neighbour but never moves.
+    SurfaceTracker tracker(testing::make_test_sphere(), TrackerOptions{});
+    SurfaceMesh& mesh = tracker.mesh();
+    std::vector<std::uint8_t> pinned(static_cast<size_t>(mesh.num_vertices()), 0);
+    std::vector<Vec3> start = mesh.positions();
+    std::vector<Vec3> velocities(start.size(), Vec3::Zero());
+    for (size_t vi = 0; vi < start.size(); ++vi) {
+        pinned[vi] = start[vi].z() < 0.0 ? 1 : 0;
+        velocities[vi] = Vec3(-start[vi].y(), start[vi].x(), 0.3);  // swirl and lift
+    }
+    const IntegrateResult moved = tracker.integrate(velocities, 0.05, &pinned);
+    EXPECT_TRUE(moved.collisions.collision_free);
+    int free_moved = 0;
+    for (size_t vi = 0; vi < start.size(); ++vi) {
+        if (pinned[vi]) {
+            EXPECT_EQ(mesh.position(static_cast<int>(vi)), start[vi]);
+        } else {
+            free_moved += mesh.position(static_cast<int>(vi)) != start[vi] ? 1 : 0;
+        }
+    }
+    EXPECT_GT(free_moved, 0);
+    start = mesh.positions();
+    TrackerOptions coarse;
+    coarse.remesh.min_edge_fraction = 0.9;  // collapse much of the mesh
+    coarse.characteristic_length = 1.5 * testing::mean_edge_length(mesh);
+    SurfaceTracker coarsening(mesh, coarse);
+    const ImproveReport r = coarsening.improve(&pinned);
+    EXPECT_GT(r.collapse.collapses, 0);
+    EXPECT_GT(r.smooth.vertices_moved, 0);
+    for (size_t vi = 0; vi < start.size(); ++vi) {
+        if (pinned[vi] && coarsening.mesh().vertex_alive(static_cast<int>(vi))) {
+            EXPECT_EQ(coarsening.mesh().position(static_cast<int>(vi)), start[vi]);
+        }
+    }
+    EXPECT_TRUE(validate_mesh(coarsening.mesh()).empty());
+    EXPECT_TRUE(is_intersection_free(coarsening.mesh()));
 }
 
 TEST(Flip, NonManifoldEdgeFlipsOnAConsistentlyOrientedPairOfOneBody) {

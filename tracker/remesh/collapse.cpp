@@ -95,7 +95,8 @@ struct PlanCandidates {
     std::optional<EdgePointRule> on_surface;
 };
 
-PlanCandidates plan_collapse(const SurfaceMesh& mesh, int ei, const RemeshOptions& options) {
+PlanCandidates plan_collapse(const SurfaceMesh& mesh, int ei, const RemeshOptions& options,
+                             const ImproveContext& context) {
     const Edge& e = mesh.edge(ei);
     const FeatureThresholds thresholds{options.ridge_eigenvalue_ratio,
                                        options.corner_eigenvalue_ratio};
@@ -104,10 +105,11 @@ PlanCandidates plan_collapse(const SurfaceMesh& mesh, int ei, const RemeshOption
     base.ei = ei;
     base.kept = e[0];
     base.removed = e[1];
-    const bool boundary0 = mesh.is_boundary_vertex(e[0]);
-    const bool boundary1 = mesh.is_boundary_vertex(e[1]);
+    const bool boundary0 = mesh.is_boundary_vertex(e[0]) || context.is_pinned(e[0]);
+    const bool boundary1 = mesh.is_boundary_vertex(e[1]) || context.is_pinned(e[1]);
     if (boundary0 || boundary1) {
-        // §4.4: the boundary stays where it is; the interior endpoint moves onto it.
+        // §4.4: the boundary stays where it is; the interior endpoint moves onto it. So does a
+        // pinned vertex (of two, the first stays).
         base.kept = boundary0 ? e[0] : e[1];
         base.removed = mesh.other_vertex(ei, base.kept);
         base.position = mesh.position(base.kept);
@@ -368,7 +370,7 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
                 ++report.refused_topology;
                 continue;
             }
-            const PlanCandidates candidates = plan_collapse(mesh, ei, options);
+            const PlanCandidates candidates = plan_collapse(mesh, ei, options, context);
             Refusal refusal = Refusal::none;
             int chosen = -1;
             for (size_t k = 0; k < candidates.plans.size(); ++k) {

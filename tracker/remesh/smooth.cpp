@@ -226,6 +226,8 @@ SmoothReport smooth_null_space(SurfaceMesh& mesh, const RemeshOptions& options,
         const std::vector<Vec3> x_t0 = mesh.positions();
         std::vector<Vec3> x_t1 = x_t0;
         for (size_t vi = 0; vi < x_t1.size(); ++vi) {
+            if (context.is_pinned(static_cast<int>(vi)))
+                continue;  // held in place, like an open surface's boundary
             x_t1[vi] += displacement[vi];
             report.vertices_moved += displacement[vi].squaredNorm() > 0.0 ? 1 : 0;
         }
@@ -233,11 +235,14 @@ SmoothReport smooth_null_space(SurfaceMesh& mesh, const RemeshOptions& options,
         if (context.collision_safety && options.smoothing_holds_colliding_vertices) {
             hold_colliding_vertices(mesh, x_t0, x_t1, report);
         } else if (context.collision_safety) {
-            // Collision response must not move the open boundary either (§4.4).
+            // Collision response must not move the open boundary either (§4.4), nor pinned
+            // vertices.
             std::vector<std::uint8_t> pinned(x_t0.size(), 0);
             for (int vi = 0; vi < mesh.num_vertices(); ++vi)
                 pinned[static_cast<size_t>(vi)] =
-                    mesh.vertex_alive(vi) && mesh.is_boundary_vertex(vi) ? 1 : 0;
+                    mesh.vertex_alive(vi) && (mesh.is_boundary_vertex(vi) || context.is_pinned(vi))
+                        ? 1
+                        : 0;
             report.collisions = resolve_collisions(mesh, x_t0, x_t1, PSEUDO_STEP_DURATION,
                                                    context.collision, nullptr, &pinned);
             if (!report.collisions.collision_free) {
