@@ -38,8 +38,56 @@ void enum_field(V& v, const char* key, Enum& value,
             value = e;
 }
 
-const std::vector<std::pair<std::string, fluid::WallType>> WALL_TYPES = {
-    {"free_slip", fluid::WallType::free_slip}, {"no_slip", fluid::WallType::no_slip}};
+const std::vector<std::pair<std::string, fluid::BoundaryType>> BOUNDARY_TYPES = {
+    {"free_slip", fluid::BoundaryType::free_slip},
+    {"no_slip", fluid::BoundaryType::no_slip},
+    {"inflow", fluid::BoundaryType::inflow},
+    {"outflow", fluid::BoundaryType::outflow}};
+const char* const FACE_NAMES[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
+
+template <typename V>
+void visit_fields(V& v, fluid::FaceBoundary& o) {
+    enum_field(v, "type", o.type, BOUNDARY_TYPES,
+               "free_slip or no_slip wall, inflow (a prescribed velocity into the box) or outflow "
+               "(fixed pressure, zero-gradient velocity)");
+    v.vec3("velocity", o.velocity, Range::any(), "m/s",
+           "no_slip: the wall's velocity along itself (a moving wall; normal component 0)");
+    v.number("pressure", o.pressure, Range::any(), "Pa", "outflow: the pressure on the face");
+    v.section("inflow", "inflow: what flows in, where and how fast", [&](auto& r) {
+        r.number("speed", o.inflow.speed, Range::non_negative(), "m/s",
+                 "mean normal speed into the box over the region");
+        enum_field(r, "profile", o.inflow.profile,
+                   {{"uniform", fluid::InflowProfile::uniform},
+                    {"parabolic", fluid::InflowProfile::parabolic}},
+                   "uniform, or parabolic: zero at the region's rim on walls (disc: 2U(1 - r²/R²); "
+                   "whole face: 3/2 U (1 - s²) across each axis walled on both sides)");
+        enum_field(r, "region", o.inflow.region,
+                   {{"face", fluid::InflowRegion::face}, {"disc", fluid::InflowRegion::disc}},
+                   "the whole face, or a disc (a nozzle; the rest of the face is a no-slip wall)");
+        r.vec3("centre", o.inflow.centre, Range::any(), "m",
+               "disc: its centre (the coordinate along the face's normal is ignored)");
+        r.number("radius", o.inflow.radius, Range::non_negative(), "m", "disc: its radius");
+        enum_field(r, "phase", o.inflow.phase,
+                   {{"liquid", fluid::InflowPhase::liquid}, {"gas", fluid::InflowPhase::gas}},
+                   "what flows in");
+    });
+}
+
+/// A face of /fluid/boundaries: a type name alone, or an object of visit_fields(FaceBoundary).
+void face_field(JsonReader& r, const char* name, fluid::FaceBoundary& face, bool) {
+    if (r.has(name) && r.raw(name).is_string()) {
+        enum_field(r, name, face.type, BOUNDARY_TYPES, "");
+        return;
+    }
+    r.section(name, "", [&](JsonReader& f) { visit_fields(f, face); });
+}
+
+/// The reference describes x_min alone (`described`); the other faces are alike.
+void face_field(ReferenceWriter& r, const char* name, fluid::FaceBoundary& face, bool described) {
+    if (described)
+        r.section(name, "the x_min face; x_max, y_min, y_max, z_min and z_max alike",
+                  [&](ReferenceWriter& f) { visit_fields(f, face); });
+}
 
 template <typename V>
 void visit_fields(V& v, DomainOptions& o) {
@@ -65,27 +113,15 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
         r.number("sigma", o.phases.sigma, Range::non_negative(), "N/m",
                  "surface tension coefficient");
     });
-    v.section("walls", "boundary condition of each box wall", [&](auto& r) {
-        enum_field(r, "x_min", o.walls.x_min, WALL_TYPES, "wall at min x");
-        enum_field(r, "x_max", o.walls.x_max, WALL_TYPES, "wall at max x");
-        enum_field(r, "y_min", o.walls.y_min, WALL_TYPES, "wall at min y");
-        enum_field(r, "y_max", o.walls.y_max, WALL_TYPES, "wall at max y");
-        enum_field(r, "z_min", o.walls.z_min, WALL_TYPES, "wall at min z");
-        enum_field(r, "z_max", o.walls.z_max, WALL_TYPES, "wall at max z");
-        // A no-slip wall may slide along itself (a moving wall: shear flows, a drop in shear).
-        r.vec3("x_min_velocity", o.walls.x_min_velocity, Range::any(), "m/s",
-               "velocity of the x_min wall along itself (x component 0; no_slip walls only)");
-        r.vec3("x_max_velocity", o.walls.x_max_velocity, Range::any(), "m/s",
-               "velocity of the x_max wall along itself (x component 0; no_slip walls only)");
-        r.vec3("y_min_velocity", o.walls.y_min_velocity, Range::any(), "m/s",
-               "velocity of the y_min wall along itself (y component 0; no_slip walls only)");
-        r.vec3("y_max_velocity", o.walls.y_max_velocity, Range::any(), "m/s",
-               "velocity of the y_max wall along itself (y component 0; no_slip walls only)");
-        r.vec3("z_min_velocity", o.walls.z_min_velocity, Range::any(), "m/s",
-               "velocity of the z_min wall along itself (z component 0; no_slip walls only)");
-        r.vec3("z_max_velocity", o.walls.z_max_velocity, Range::any(), "m/s",
-               "velocity of the z_max wall along itself (z component 0; no_slip walls only)");
-    });
+    v.section("boundaries",
+              "the six faces of the box (x_min, x_max, y_min, y_max, z_min, z_max): each a "
+              "boundary type as a string (\"no_slip\") or an object like x_min's",
+              [&](auto& r) {
+                  for (int axis = 0; axis < 3; ++axis)
+                      for (int side = 0; side < 2; ++side)
+                          face_field(r, FACE_NAMES[axis][side], o.boundaries.face(axis, side),
+                                     axis == 0 && side == 0);
+              });
     enum_field(v, "advection", o.advection.scheme,
                {{"maccormack", fluid::AdvectionScheme::maccormack},
                 {"bfecc", fluid::AdvectionScheme::bfecc},

@@ -15,7 +15,7 @@ using Triplet = Eigen::Triplet<double>;
 
 std::shared_ptr<const fluid::SurfaceViscosity> build_surface_viscosity(
     const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid, double viscosity,
-    const InterpolateOptions& interpolate, const fluid::WallOptions& walls) {
+    const InterpolateOptions& interpolate, const fluid::BoundaryOptions& walls) {
     if (!(viscosity >= 0.0) || !std::isfinite(viscosity))
         throw std::invalid_argument("build_surface_viscosity: viscosity must be finite and >= 0");
     const Vector3d lo = grid.origin();

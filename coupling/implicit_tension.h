@@ -24,6 +24,6 @@ namespace meniscus::coupling {
 /// viscosity.
 std::shared_ptr<const fluid::SurfaceViscosity> build_surface_viscosity(
     const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid, double viscosity,
-    const InterpolateOptions& interpolate, const fluid::WallOptions& walls);
+    const InterpolateOptions& interpolate, const fluid::BoundaryOptions& walls);
 
 }  // namespace meniscus::coupling

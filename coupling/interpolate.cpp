@@ -229,7 +229,7 @@ std::array<T, 3> sample_components(const fluid::MacGrid& grid, const Eigen::Vect
 template <typename T>
 std::array<T, 3> sample_vertex(const fluid::MacGrid& grid, Eigen::Vector3d x, Eigen::Vector3d n,
                                const InterpolateOptions& options,
-                               const fluid::WallOptions& walls) {
+                               const fluid::BoundaryOptions& walls) {
     const Eigen::Vector3d lo = grid.origin();
     const Eigen::Vector3d hi =
         lo + grid.dx() * Eigen::Vector3d(grid.nx(), grid.ny(), grid.nz());
@@ -237,7 +237,7 @@ std::array<T, 3> sample_vertex(const fluid::MacGrid& grid, Eigen::Vector3d x, Ei
     if (options.outside == OutsideVelocity::mirror)
         for (int d = 0; d < 3; ++d) {
             const int side = x[d] < lo[d] ? 0 : x[d] > hi[d] ? 1 : -1;
-            if (side < 0 || walls.at(d, side) != fluid::WallType::free_slip)
+            if (side < 0 || walls.at(d, side) != fluid::BoundaryType::free_slip)
                 continue;
             const double plane = side == 0 ? lo[d] : hi[d];
             x[d] = 2.0 * plane - x[d];
@@ -271,7 +271,7 @@ Eigen::Vector3d sample_grid_velocity(const fluid::MacGrid& grid, const Eigen::Ve
 std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& grid,
                                                          const tracker::SurfaceMesh& mesh,
                                                          const InterpolateOptions& options,
-                                                         const fluid::WallOptions& walls) {
+                                                         const fluid::BoundaryOptions& walls) {
     options.validate();
     walls.validate();
     std::vector<tracker::Vec3> velocities(static_cast<size_t>(mesh.num_vertices()),
@@ -296,7 +296,7 @@ std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& g
 
 Eigen::SparseMatrix<double, Eigen::RowMajor> vertex_velocity_weights(
     const fluid::MacGrid& grid, const tracker::SurfaceMesh& mesh, const std::vector<int>& vertices,
-    const InterpolateOptions& options, const fluid::WallOptions& walls) {
+    const InterpolateOptions& options, const fluid::BoundaryOptions& walls) {
     options.validate();
     walls.validate();
     const std::vector<tracker::Vec3> normals = options.method == VelocityInterpolation::one_sided

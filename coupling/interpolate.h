@@ -5,6 +5,7 @@
 /// origin + (i, j+½, k+½)·dx, etc.; see fluid/mac_grid.h), so every method reproduces any linear
 /// velocity field exactly wherever its stencil lies inside the face lattice.
 
+#include "fluid/boundary.h"
 #include "fluid/mac_grid.h"
 #include "tracker/mesh.h"
 
@@ -83,7 +84,7 @@ Eigen::Vector3d sample_grid_velocity(const fluid::MacGrid& grid, const Eigen::Ve
 std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& grid,
                                                          const tracker::SurfaceMesh& mesh,
                                                          const InterpolateOptions& options = {},
-                                                         const fluid::WallOptions& walls = {});
+                                                         const fluid::BoundaryOptions& walls = {});
 
 /// The weights behind interpolate_vertex_velocities(): row 3p + a holds the weights of the face
 /// velocities whose sum is component a of the velocity of vertex `vertices[p]` — the same method,
@@ -92,6 +93,6 @@ std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& g
 /// std::invalid_argument on invalid options or a vertex that is not live.
 Eigen::SparseMatrix<double, Eigen::RowMajor> vertex_velocity_weights(
     const fluid::MacGrid& grid, const tracker::SurfaceMesh& mesh, const std::vector<int>& vertices,
-    const InterpolateOptions& options = {}, const fluid::WallOptions& walls = {});
+    const InterpolateOptions& options = {}, const fluid::BoundaryOptions& walls = {});
 
 }  // namespace meniscus::coupling

@@ -106,7 +106,7 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     if (m_options.implicit_tension > 0.0 && phases.sigma > 0.0)
         interface.surface_viscosity = build_surface_viscosity(
             mesh, grid, m_options.implicit_tension * phases.sigma * report.dt,
-            m_options.interpolate, m_fluid.options().walls);
+            m_options.interpolate, m_fluid.options().boundaries);
     clock.lap_into(timings.curvature);
 
     // (3) Fluid.
@@ -130,7 +130,7 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     // (4) Grid → mesh.
     m_vertex_velocities =
         interpolate_vertex_velocities(m_fluid.grid(), mesh, m_options.interpolate,
-                                      m_fluid.options().walls);
+                                      m_fluid.options().boundaries);
     for (const tracker::Vec3& v : m_vertex_velocities)
         report.max_vertex_speed = std::max(report.max_vertex_speed, v.norm());
     clock.lap_into(timings.interpolate);

@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <array>
 #include <stdexcept>
 
@@ -36,11 +37,51 @@ bool is_fixed_sample(FieldLocation location, const Array3<double>& field, int i,
     return false;
 }
 
+/// The inflow faces across which a component's samples are tangential: for each, the axis, the
+/// side and the box's cell count along the axis.
+struct TangentialInflow {
+    int axis = 0;
+    int side = 0;
+    int cells = 0;
+};
+
+std::vector<TangentialInflow> tangential_inflows(const MacGrid& grid, FieldLocation location,
+                                                 const BoundaryOptions* boundaries) {
+    std::vector<TangentialInflow> faces;
+    if (!boundaries || location == FieldLocation::cell_centre)
+        return faces;
+    const int component =
+        location == FieldLocation::x_face ? 0 : (location == FieldLocation::y_face ? 1 : 2);
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side)
+            if (axis != component && boundaries->at(axis, side) == BoundaryType::inflow)
+                faces.push_back({axis, side, grid.cells(axis)});
+    return faces;
+}
+
+/// A departure point `g` (cell units) of a tangential component near an inflow face: the
+/// inflowing fluid has no tangential velocity, so between the face and the first sample half a
+/// cell inside the value falls linearly to 0, and beyond the face it is 0. Scales the sample
+/// and widens its bounds to 0.
+void apply_tangential_inflows(const std::vector<TangentialInflow>& faces, const Eigen::Vector3d& g,
+                              TrilinearSample& sample) {
+    for (const TangentialInflow& f : faces) {
+        const double from_face = f.side == 0 ? g[f.axis] : f.cells - g[f.axis];
+        if (from_face >= HALF)
+            continue;
+        sample.value *= std::max(0.0, from_face) / HALF;
+        sample.min = std::min(sample.min, 0.0);
+        sample.max = std::max(sample.max, 0.0);
+    }
+}
+
 /// One semi-Lagrangian pass: out(x) = in(x − dt·u) with RK2 back-tracing; `dt` may be negative
 /// (forward trace). When bounds are requested, the min/max of the interpolation stencil is stored.
+/// `inflows`: the inflow faces to which the field's samples are tangential.
 void semi_lagrangian(const std::array<const Array3<double>*, 3>& velocity, double inverse_dx,
                      double dt, FieldLocation location, const Array3<double>& in,
-                     Array3<double>& out, Array3<double>* lower, Array3<double>* upper) {
+                     Array3<double>& out, Array3<double>* lower, Array3<double>* upper,
+                     const std::vector<TangentialInflow>& inflows) {
     const Eigen::Vector3d offset = field_offset(location);
     tbb::parallel_for(tbb::blocked_range<int>(0, in.nk()), [&](const tbb::blocked_range<int>& r) {
         for (int k = r.begin(); k != r.end(); ++k) {
@@ -60,11 +101,14 @@ void semi_lagrangian(const std::array<const Array3<double>*, 3>& velocity, doubl
                         start - HALF * dt * grid_velocity(velocity, start, inverse_dx);
                     const Eigen::Vector3d departure =
                         start - dt * grid_velocity(velocity, mid, inverse_dx);
-                    if (lower != nullptr) {
-                        const TrilinearSample sample = sample_trilinear(in, location, departure);
+                    if (lower != nullptr || !inflows.empty()) {
+                        TrilinearSample sample = sample_trilinear(in, location, departure);
+                        apply_tangential_inflows(inflows, departure, sample);
                         out[c] = sample.value;
-                        (*lower)[c] = sample.min;
-                        (*upper)[c] = sample.max;
+                        if (lower != nullptr) {
+                            (*lower)[c] = sample.min;
+                            (*upper)[c] = sample.max;
+                        }
                     } else {
                         out[c] = interpolate_trilinear(in, location, departure);
                     }
@@ -84,20 +128,23 @@ void AdvectionOptions::validate() const {
 }
 
 void advect_field(const MacGrid& grid, double dt, FieldLocation location,
-                  const AdvectionOptions& options, Array3<double>& field) {
+                  const AdvectionOptions& options, Array3<double>& field,
+                  const BoundaryOptions* boundaries) {
     options.validate();
+    const std::vector<TangentialInflow> inflows = tangential_inflows(grid, location, boundaries);
     const std::array<const Array3<double>*, 3> velocity = {&grid.u(), &grid.v(), &grid.w()};
     const double inverse_dx = 1.0 / grid.dx();
     const int ni = field.ni(), nj = field.nj(), nk = field.nk();
     Array3<double> forward(ni, nj, nk);
     Array3<double> lower(ni, nj, nk), upper(ni, nj, nk);
-    semi_lagrangian(velocity, inverse_dx, dt, location, field, forward, &lower, &upper);
+    semi_lagrangian(velocity, inverse_dx, dt, location, field, forward, &lower, &upper, inflows);
     if (options.scheme == AdvectionScheme::semi_lagrangian) {
         field = std::move(forward);
         return;
     }
     Array3<double> backward(ni, nj, nk);
-    semi_lagrangian(velocity, inverse_dx, -dt, location, forward, backward, nullptr, nullptr);
+    semi_lagrangian(velocity, inverse_dx, -dt, location, forward, backward, nullptr, nullptr,
+                    inflows);
     Array3<double> corrected(ni, nj, nk);
     if (options.scheme == AdvectionScheme::bfecc) {
         // Advect φ0 + (φ0 − φ̂0)/2 forward again.
@@ -106,7 +153,7 @@ void advect_field(const MacGrid& grid, double dt, FieldLocation location,
             compensated[c] = field[c] + HALF * (field[c] - backward[c]);
         }
         semi_lagrangian(velocity, inverse_dx, dt, location, compensated, corrected, nullptr,
-                        nullptr);
+                        nullptr, inflows);
     } else {
         // MacCormack: φ1 + (φ0 − φ̂0)/2.
         for (std::size_t c = 0; c < field.size(); ++c) {
@@ -119,11 +166,12 @@ void advect_field(const MacGrid& grid, double dt, FieldLocation location,
     }
 }
 
-void advect_velocity(MacGrid& grid, double dt, const AdvectionOptions& options) {
+void advect_velocity(MacGrid& grid, double dt, const AdvectionOptions& options,
+                     const BoundaryOptions* boundaries) {
     const MacGrid start = grid;
     for (int axis = 0; axis < 3; ++axis) {
         Array3<double> component = start.velocity(axis);
-        advect_field(start, dt, face_location(axis), options, component);
+        advect_field(start, dt, face_location(axis), options, component, boundaries);
         grid.velocity(axis) = std::move(component);
     }
 }

@@ -4,10 +4,13 @@
 ///
 /// Departure points are traced back with explicit midpoint RK2 through the face velocities
 /// (trilinear interpolation of each staggered component on its own lattice). Points that leave the
-/// box are sampled with constant extrapolation of the nearest samples. Every scheme reproduces
+/// box are sampled with constant extrapolation of the nearest samples, except for the velocity
+/// components tangential to an inflow face (boundary.h): the inflow brings no tangential
+/// velocity, so they fall linearly to 0 from the first sample to the face and are 0 beyond it. Every scheme reproduces
 /// constant fields exactly and linear fields exactly wherever the departure points stay in the box.
 
 #include "fluid/array3.h"
+#include "fluid/boundary.h"
 #include "fluid/mac_grid.h"
 
 namespace meniscus::fluid {
@@ -31,11 +34,15 @@ struct AdvectionOptions {
 /// seconds. The result replaces `field`. For corrected schemes, a corrected value outside the
 /// [min, max] of the 8 samples around the forward departure point falls back to the plain
 /// semi-Lagrangian value. Wall-normal faces of a face-located field are left unchanged.
+/// `boundaries` (optional): the inflow faces (see the file comment; no effect on cell-centred
+/// fields).
 void advect_field(const MacGrid& grid, double dt, FieldLocation location,
-                  const AdvectionOptions& options, Array3<double>& field);
+                  const AdvectionOptions& options, Array3<double>& field,
+                  const BoundaryOptions* boundaries = nullptr);
 
 /// Self-advection of the face velocities of `grid` for `dt` seconds: each component is advected
 /// through the velocity field at the start of the step. Wall-normal faces keep their values.
-void advect_velocity(MacGrid& grid, double dt, const AdvectionOptions& options);
+void advect_velocity(MacGrid& grid, double dt, const AdvectionOptions& options,
+                     const BoundaryOptions* boundaries = nullptr);
 
 }  // namespace meniscus::fluid

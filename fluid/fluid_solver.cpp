@@ -55,9 +55,9 @@ void FluidOptions::validate() const {
         throw std::invalid_argument("FluidOptions.gravity must be finite (m/s^2)");
     }
     try {
-        walls.validate();
+        boundaries.validate();
     } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(std::string("walls/") + e.what());
+        throw std::invalid_argument(std::string("boundaries/") + e.what());
     }
     advection.validate();
     viscosity.validate();
@@ -71,7 +71,9 @@ void FluidOptions::validate() const {
 
 FluidSolver::FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3d& origin,
                          const FluidOptions& options)
-    : m_options(validated(options)), m_grid(nx, ny, nz, dx, origin), m_pressure(nx, ny, nz, 0.0) {}
+    : m_options(validated(options)), m_grid(nx, ny, nz, dx, origin), m_pressure(nx, ny, nz, 0.0) {
+    apply_boundary_velocity(m_grid, m_options.boundaries);
+}
 
 StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
     if (!(dt > 0.0)) {
@@ -81,8 +83,8 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
     StepResult result;
     PhaseClock step_clock;
     PhaseClock clock;
-    advect_velocity(m_grid, dt, m_options.advection);
-    m_grid.zero_wall_normal_velocity();
+    advect_velocity(m_grid, dt, m_options.advection, &m_options.boundaries);
+    apply_boundary_velocity(m_grid, m_options.boundaries);
     clock.lap_into(result.timings.advection);
 
     if (m_options.viscous_pressure.coupling == ViscousPressureCoupling::split) {
@@ -106,15 +108,16 @@ void FluidSolver::split_step(double dt, const InterfaceInput& interface, StepRes
     // projection, so a fluid at rest in hydrostatic equilibrium stays exactly at rest.
     PhaseClock clock;
     result.viscosity = m_viscosity.solve(m_grid, interface, m_options.phases, m_options.mode,
-                                         m_options.walls, dt, m_options.viscosity,
+                                         m_options.boundaries, dt, m_options.viscosity,
                                          m_options.pressure.min_liquid_fraction);
     clock.lap_into(result.timings.viscosity);
 
-    apply_gravity(m_grid, m_options.gravity, dt);
+    apply_gravity(m_grid, m_options.gravity, dt, m_options.boundaries);
     clock.lap_into(result.timings.forces);
 
-    const ProjectionResult projection = project(m_grid, interface, m_options.phases, m_options.mode,
-                                                dt, m_options.pressure, m_pressure);
+    const ProjectionResult projection =
+        project(m_grid, interface, m_options.phases, m_options.mode, dt, m_options.pressure,
+                m_pressure, m_options.boundaries);
     result.pressure = projection.solve;
     result.max_divergence = projection.max_divergence;
     result.timings.pressure_build += projection.build_time;
@@ -127,6 +130,9 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
     const FluidMode mode = m_options.mode;
     const ViscousPressureOptions& scheme = m_options.viscous_pressure;
     const SurfaceViscosity* surface = interface.surface_viscosity.get();
+    const BoundaryOptions& boundaries = m_options.boundaries;
+    // The increments are homogeneous: walls at rest, inflows still, outflows at zero pressure.
+    const BoundaryOptions increment_boundaries = boundaries.at_rest();
     const bool implicit_tension = surface && surface->active();
     const bool viscous = (m_options.viscosity.enabled &&
                           (phases.mu_liquid > 0.0 ||
@@ -152,14 +158,15 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
         // No previous pressure: start from the one that balances the body force and the jump
         // (hydrostatic plus Laplace), so that rest is exact from the first step.
         MacGrid body(m_grid.nx(), m_grid.ny(), m_grid.nz(), m_grid.dx(), m_grid.origin());
-        apply_gravity(body, m_options.gravity, dt);
+        apply_gravity(body, m_options.gravity, dt, boundaries);
         add_solve(result.pressure, project(body, interface, phases, mode, dt,
-                                           m_options.pressure, m_pressure)
+                                           m_options.pressure, m_pressure, boundaries)
                                        .solve);
     }
     carry_pressure_to_new_phase(m_was_liquid, interface, phases, mode, m_pressure);
-    apply_gravity(m_grid, m_options.gravity, dt);
-    apply_pressure_gradient(m_grid, interface, phases, mode, dt, m_options.pressure, m_pressure);
+    apply_gravity(m_grid, m_options.gravity, dt, boundaries);
+    apply_pressure_gradient(m_grid, interface, phases, mode, dt, m_options.pressure, m_pressure,
+                            boundaries);
     if (mode == FluidMode::free_surface) {
         // Gas faces took the body force but no pressure: give them the liquid's velocity again,
         // or the viscous solve would drag the liquid along with them (rest would not be exact).
@@ -167,7 +174,7 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
     }
     clock.lap_into(result.timings.forces);
     add_solve(result.viscosity,
-              m_viscosity.solve(m_grid, interface, phases, mode, m_options.walls, dt,
+              m_viscosity.solve(m_grid, interface, phases, mode, boundaries, dt,
                                 m_options.viscosity, m_options.pressure.min_liquid_fraction));
     clock.lap_into(result.timings.viscosity);
 
@@ -213,13 +220,11 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
         std::vector<double> z, q;
         Array3<double> direction;
         MacGrid impulse(1, 1, 1, dx);
-        // The impulses are velocity increments: homogeneous, so moving walls stand still for them.
-        const WallOptions walls_at_rest = m_options.walls.at_rest();
         double rz = 0.0;
         if (!result.converged_passes) {
             clock.lap_into(result.timings.pressure_solve);
             system = build_pressure_system(m_grid, interface, increment_phases, mode, dt,
-                                           m_options.pressure);
+                                           m_options.pressure, increment_boundaries);
             clock.lap_into(result.timings.pressure_build);
             poisson = std::make_unique<PressureSystemSolver>(system, m_options.pressure);
             add_solve(result.pressure, apply_cahouet_chabard(system, *poisson, scheme.preconditioner,
@@ -236,9 +241,9 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
             for (int axis = 0; axis < 3; ++axis)
                 impulse.velocity(axis).fill(0.0);
             apply_pressure_gradient(impulse, interface, increment_phases, mode, dt,
-                                    m_options.pressure, direction);
+                                    m_options.pressure, direction, increment_boundaries);
             add_solve(result.viscosity,
-                      m_viscosity.solve(impulse, interface, phases, mode, walls_at_rest, dt,
+                      m_viscosity.solve(impulse, interface, phases, mode, increment_boundaries, dt,
                                         m_options.viscosity,
                                         m_options.pressure.min_liquid_fraction));
             clock.lap_into(result.timings.viscosity);
@@ -280,7 +285,8 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
     // The projection of what is left: u divergence-free to the pressure solver's tolerance.
     clock = PhaseClock();
     const ProjectionResult projection = project(m_grid, interface, increment_phases, mode, dt,
-                                                m_options.pressure, m_increment);
+                                                m_options.pressure, m_increment,
+                                                increment_boundaries);
     for (std::size_t c = 0; c < m_pressure.size(); ++c)
         m_pressure[c] += m_increment[c];
     if (projection.singular)

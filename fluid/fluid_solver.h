@@ -4,8 +4,8 @@
 ///
 /// The solver never sees the interface mesh: each step receives an InterfaceInput (φ at cell
 /// centres, negative in the liquid; κ on the faces it crosses; see interface_input.h). All
-/// quantities are SI. The box is closed: the normal velocity on every wall is zero; no-slip walls
-/// may slide along themselves (WallOptions' velocities).
+/// quantities are SI. Each face of the box is a wall (no-slip walls may slide along themselves),
+/// an inflow or an outflow (FluidOptions::boundaries, boundary.h).
 
 #include <Eigen/Core>
 
@@ -14,6 +14,7 @@
 #include "common/phase_clock.h"
 
 #include "fluid/advection.h"
+#include "fluid/boundary.h"
 #include "fluid/array3.h"
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
@@ -31,7 +32,7 @@ struct FluidOptions {
     PhaseOptions phases;
     FluidMode mode = FluidMode::two_phase;
     Eigen::Vector3d gravity = Eigen::Vector3d(0.0, 0.0, -9.81);  ///< m/s² (z up by default)
-    WallOptions walls;
+    BoundaryOptions boundaries;  ///< the six faces of the box (boundary.h)
     AdvectionOptions advection;
     ViscosityOptions viscosity;
     PressureOptions pressure;

@@ -1,5 +1,5 @@
 #pragma once
-/// \file Staggered MAC grid: geometry, face velocities, wall types and staggered interpolation.
+/// \file Staggered MAC grid: geometry, face velocities and staggered interpolation.
 ///
 /// Conventions (used by every file in fluid/):
 /// - The box is [origin, origin + (nx, ny, nz)·dx], cubic cells of edge dx (metres).
@@ -10,7 +10,8 @@
 ///   v(i, j, k) at origin + (i+½, j, k+½)·dx, array nx × (ny+1) × nz;
 ///   w(i, j, k) at origin + (i+½, j+½, k)·dx, array nx × ny × (nz+1).
 /// - Faces with i = 0 or i = nx (resp. j, k) lie on the domain walls; the velocity stored there is
-///   the prescribed normal velocity of the wall (zero for a stationary wall).
+///   the normal velocity of the box face (boundary.h: zero on walls, the inflow's, or the
+///   projection's on an outflow).
 /// - Axes are numbered 0 = x, 1 = y, 2 = z; sides 0 = min wall, 1 = max wall.
 
 #include <array>
@@ -20,46 +21,6 @@
 #include "fluid/array3.h"
 
 namespace meniscus::fluid {
-
-/// Boundary condition of a domain wall for the tangential velocity. The normal velocity is always
-/// the stored wall value (zero for a closed box).
-enum class WallType {
-    free_slip,  ///< zero shear stress: tangential velocity is free
-    no_slip     ///< tangential velocity is zero on the wall
-};
-
-/// Wall type of each of the six box walls, and the velocity of each no-slip wall sliding along
-/// itself (a moving wall: the fluid next to it is dragged at that velocity).
-struct WallOptions {
-    WallType x_min = WallType::free_slip;
-    WallType x_max = WallType::free_slip;
-    WallType y_min = WallType::free_slip;
-    WallType y_max = WallType::free_slip;
-    WallType z_min = WallType::free_slip;
-    WallType z_max = WallType::free_slip;
-    /// Tangential velocity of each wall (m/s); the component along the wall's normal must be 0,
-    /// and only a no-slip wall may move.
-    Eigen::Vector3d x_min_velocity = Eigen::Vector3d::Zero();
-    Eigen::Vector3d x_max_velocity = Eigen::Vector3d::Zero();
-    Eigen::Vector3d y_min_velocity = Eigen::Vector3d::Zero();
-    Eigen::Vector3d y_max_velocity = Eigen::Vector3d::Zero();
-    Eigen::Vector3d z_min_velocity = Eigen::Vector3d::Zero();
-    Eigen::Vector3d z_max_velocity = Eigen::Vector3d::Zero();
-
-    /// Wall on `axis` (0..2) at `side` (0 = min, 1 = max). Throws std::invalid_argument otherwise.
-    WallType at(int axis, int side) const;
-    /// Velocity of the wall on `axis` at `side` (m/s). Throws std::invalid_argument like at().
-    const Eigen::Vector3d& velocity_at(int axis, int side) const;
-    /// True if any wall moves.
-    bool moving() const;
-    /// The same walls, every one at rest (for the homogeneous solves of velocity increments).
-    WallOptions at_rest() const;
-    /// All six walls set to `type`, at rest.
-    static WallOptions all(WallType type);
-    /// Throws std::invalid_argument naming the field if an enum holds an unknown value, or a
-    /// velocity is not finite, has a normal component, or belongs to a free-slip wall.
-    void validate() const;
-};
 
 /// Where the samples of a grid field live (see the file comment).
 enum class FieldLocation { x_face, y_face, z_face, cell_centre };

@@ -11,6 +11,10 @@ namespace meniscus::fluid {
 
 namespace {
 
+/// An outflow face lies half a cell from the centre of its cell (like a free-surface ghost face
+/// with θ = ½).
+constexpr double OUTFLOW_FRACTION = 0.5;
+
 /// How one interior face enters the pressure system.
 struct FaceCoupling {
     enum class Kind {
@@ -75,6 +79,47 @@ void for_each_interior_face(const MacGrid& grid, int axis, Visit&& visit) {
     }
 }
 
+/// Calls visit(axis, face index (i, j, k), the cell inside it, its coupling) for every boundary face
+/// of an outflow side of the box whose cell is an unknown: a Dirichlet face with p = the
+/// outflow's pressure on the face itself, half a cell from the cell's centre (coefficient 2/ρ of
+/// the cell's phase).
+template <class Visit>
+void for_each_outflow_face(const MacGrid& grid, const InterfaceInput& interface,
+                           const PhaseOptions& phases, FluidMode mode,
+                           const BoundaryOptions& boundaries, Visit&& visit) {
+    const Array3<double>& phi = interface.phi;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side) {
+            const FaceBoundary& boundary = boundaries.face(axis, side);
+            if (boundary.type != BoundaryType::outflow)
+                continue;
+            const Array3<double>& faces = grid.velocity(axis);
+            const int ni = axis == 0 ? 1 : faces.ni();
+            const int nj = axis == 1 ? 1 : faces.nj();
+            const int nk = axis == 2 ? 1 : faces.nk();
+            for (int k = 0; k < nk; ++k)
+                for (int j = 0; j < nj; ++j)
+                    for (int i = 0; i < ni; ++i) {
+                        int face[3] = {i, j, k};
+                        int cell[3] = {i, j, k};
+                        face[axis] = side == 0 ? 0 : grid.cells(axis);
+                        cell[axis] = side == 0 ? 0 : grid.cells(axis) - 1;
+                        const double phi_cell = phi(cell[0], cell[1], cell[2]);
+                        if (!is_unknown(phi_cell, mode))
+                            continue;
+                        FaceCoupling coupling;
+                        coupling.kind = side == 0 ? FaceCoupling::Kind::dirichlet_hi
+                                                  : FaceCoupling::Kind::dirichlet_lo;
+                        const double theta = is_liquid(phi_cell) ? 1.0 : 0.0;
+                        coupling.beta = 1.0 / (OUTFLOW_FRACTION *
+                                               face_density(theta, phases, FluidMode::two_phase));
+                        coupling.boundary_pressure = boundary.pressure;
+                        visit(axis, face[0], face[1], face[2],
+                              phi.index(cell[0], cell[1], cell[2]), coupling);
+                    }
+        }
+}
+
 Array3<double>& off_diagonal(PoissonMatrix& matrix, int axis) {
     return axis == 0 ? matrix.off_x : (axis == 1 ? matrix.off_y : matrix.off_z);
 }
@@ -96,7 +141,8 @@ void PressureOptions::validate() const {
 
 PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& interface,
                                      const PhaseOptions& phases, FluidMode mode, double dt,
-                                     const PressureOptions& options) {
+                                     const PressureOptions& options,
+                                     const BoundaryOptions& boundaries) {
     interface.validate(grid);
     if (!(dt > 0.0)) {
         throw std::invalid_argument("build_pressure_system: dt must be positive (s)");
@@ -140,6 +186,12 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
             }
         });
     }
+    for_each_outflow_face(grid, interface, phases, mode, boundaries,
+                          [&](int, int, int, int, std::size_t c, const FaceCoupling& face) {
+                              a.diag[c] += face.beta;
+                              b[c] += face.beta * face.boundary_pressure;
+                              has_dirichlet = true;
+                          });
     const double flux_scale = grid.dx() * grid.dx() / dt;
     for (int k = 0; k < nz; ++k) {
         for (int j = 0; j < ny; ++j) {
@@ -228,9 +280,9 @@ SolveResult solve_pressure_system(const PressureSystem& system, const PressureOp
 void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
                              const PhaseOptions& phases, FluidMode mode, double dt,
                              const PressureOptions& options, const Array3<double>& pressure,
-                             double factor) {
+                             const BoundaryOptions& boundaries) {
     const Array3<double>& phi = interface.phi;
-    const double scale = factor * dt / grid.dx();
+    const double scale = dt / grid.dx();
     for (int axis = 0; axis < 3; ++axis) {
         Array3<double>& velocity = grid.velocity(axis);
         const Array3<double>& kappa = interface.kappa(axis);
@@ -256,6 +308,16 @@ void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
             velocity(i, j, k) -= scale * face.beta * difference;
         });
     }
+    for_each_outflow_face(grid, interface, phases, mode, boundaries,
+                          [&](int axis, int i, int j, int k, std::size_t c,
+                              const FaceCoupling& face) {
+                              // p(hi) − p(lo) across the face, the outside being the face's p.
+                              const double difference =
+                                  face.kind == FaceCoupling::Kind::dirichlet_lo
+                                      ? face.boundary_pressure - pressure[c]
+                                      : pressure[c] - face.boundary_pressure;
+                              grid.velocity(axis)(i, j, k) -= scale * face.beta * difference;
+                          });
 }
 
 double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface, FluidMode mode) {
@@ -274,14 +336,15 @@ double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface
 
 ProjectionResult project(MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,
                          FluidMode mode, double dt, const PressureOptions& options,
-                         Array3<double>& pressure) {
+                         Array3<double>& pressure, const BoundaryOptions& boundaries) {
     PhaseClock clock;
-    const PressureSystem system = build_pressure_system(grid, interface, phases, mode, dt, options);
+    const PressureSystem system =
+        build_pressure_system(grid, interface, phases, mode, dt, options, boundaries);
     ProjectionResult result;
     result.build_time = clock.lap();
     result.solve = solve_pressure_system(system, options, pressure);
     result.singular = system.singular;
-    apply_pressure_gradient(grid, interface, phases, mode, dt, options, pressure);
+    apply_pressure_gradient(grid, interface, phases, mode, dt, options, pressure, boundaries);
     result.max_divergence = max_fluid_divergence(grid, interface, mode);
     result.solve_time = clock.lap();
     return result;

@@ -8,8 +8,10 @@
 ///   Σ_faces f β_f (p_c − p_nb) = −(dx/Δt) Σ_f (outward u*_f) − Σ_f (±β_f J_f),
 /// with β_f = 1/ρ_f (ρ_f from the liquid fraction θ of the face, see face_density()) and J_f the
 /// jump p(hi side) − p(lo side) of face_pressure_jump() (p_liquid − p_gas = σκ).
-/// Wall faces are not unknowns: their stored normal velocity is kept (zero-flux walls give a
-/// Neumann condition). In free_surface mode only liquid cells are unknowns; a face to a gas cell
+/// Wall and inflow faces of the box are not unknowns: their stored normal velocity is kept (a
+/// Neumann condition). An outflow face (boundary.h) is a Dirichlet face with p = its pressure on
+/// the face, half a cell from its cell's centre: it adds 2/ρ of the cell's phase to the diagonal
+/// and its velocity takes the gradient like an interior face. In free_surface mode only liquid cells are unknowns; a face to a gas cell
 /// uses the ghost value that puts p = σκ at the θ-weighted interface position, adding β/θ to the
 /// diagonal (θ clamped below by min_liquid_fraction). Pressure in Pa.
 
@@ -18,6 +20,7 @@
 
 #include "common/phase_clock.h"
 #include "fluid/array3.h"
+#include "fluid/boundary.h"
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
 #include "fluid/mic0.h"
@@ -49,18 +52,21 @@ struct PressureOptions {
 };
 
 /// The assembled system: matrix over all nx·ny·nz cells (inactive rows zero), right-hand side and
-/// whether A is singular (pure Neumann: two_phase in a closed box, or free_surface without gas).
+/// whether A is singular (pure Neumann: two_phase in a box without outflow, or free_surface
+/// without gas nor outflow).
 struct PressureSystem {
     PoissonMatrix matrix;
     std::vector<double> rhs;
     bool singular = false;
 };
 
-/// Assembles the pressure system for the current face velocities u* of `grid` (see file comment).
+/// Assembles the pressure system for the current face velocities u* of `grid` (see file comment)
+/// in a box with `boundaries` (default: closed by free-slip walls; only the outflow faces matter).
 /// `dt` in seconds (> 0). Throws std::invalid_argument if `interface` is not sized for `grid`.
 PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& interface,
                                      const PhaseOptions& phases, FluidMode mode, double dt,
-                                     const PressureOptions& options);
+                                     const PressureOptions& options,
+                                     const BoundaryOptions& boundaries = {});
 
 /// Solves `system` with options.solver; writes the pressure (Pa) to `pressure` (nx × ny × nz,
 /// zero in cells that are not unknowns; mean zero when the system is singular).
@@ -90,13 +96,13 @@ private:
     std::unique_ptr<Preconditioner> m_preconditioner;  ///< null for eigen_ic_cg
 };
 
-/// u ← u − factor · Δt/ρ_f ∇p on every face adjacent to an unknown cell (ghost-fluid gradients
-/// with the σκ jump; free-surface faces use the interface Dirichlet value σκ). Wall faces are
-/// untouched. `factor` 1 is the projection's update; −1 adds the same impulse back.
+/// u ← u − Δt/ρ_f ∇p on every face adjacent to an unknown cell (ghost-fluid gradients with the σκ
+/// jump; free-surface faces use the interface Dirichlet value σκ, outflow faces their pressure).
+/// Wall and inflow faces are untouched.
 void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
                              const PhaseOptions& phases, FluidMode mode, double dt,
                              const PressureOptions& options, const Array3<double>& pressure,
-                             double factor = 1.0);
+                             const BoundaryOptions& boundaries = {});
 
 /// Largest |∇·u| (1/s) over the unknown cells of the pressure system (all cells in two_phase,
 /// liquid cells in free_surface).
@@ -114,6 +120,6 @@ struct ProjectionResult {
 /// Full projection: build, solve, apply the gradient. `pressure` receives p (Pa).
 ProjectionResult project(MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,
                          FluidMode mode, double dt, const PressureOptions& options,
-                         Array3<double>& pressure);
+                         Array3<double>& pressure, const BoundaryOptions& boundaries = {});
 
 }  // namespace meniscus::fluid

@@ -24,6 +24,8 @@ constexpr double SHEAR_WEIGHT = 0.5;
 constexpr double HALF = 0.5;
 /// A no-slip wall mirrors the tangential velocity: the one-sided derivative doubles.
 constexpr double MIRROR_FACTOR = 2.0;
+/// The part of an outflow face's control volume inside the box.
+constexpr double OUTFLOW_VOLUME_FRACTION = 0.5;
 
 using Index3 = std::array<int, 3>;
 
@@ -37,12 +39,15 @@ class ViscousOperator {
 public:
     /// (Re)builds the operator for a grid, interface and time step, reusing the arrays' memory.
     void build(const MacGrid& grid, const Array3<double>& phi, const PhaseOptions& phases,
-               FluidMode mode, const WallOptions& walls, double dt, double min_liquid_fraction,
+               FluidMode mode, const BoundaryOptions& walls, double dt, double min_liquid_fraction,
                ViscosityWeights weights, const SurfaceViscosity* surface) {
         m_n = {grid.nx(), grid.ny(), grid.nz()};
         m_dx = grid.dx();
         m_dt = dt;
         m_surface = surface;
+        for (int a = 0; a < 3; ++a)
+            for (int side = 0; side < 2; ++side)
+                m_open[a][side] = walls.at(a, side) == BoundaryType::outflow;
         // The surface term's energy ½ Δt μ_s (S u)ᵀ L (S u), per cell volume as the rest.
         m_surface_scale = surface ? dt * surface->viscosity / (m_dx * m_dx * m_dx) : 0.0;
         std::size_t offset = 0;
@@ -97,7 +102,7 @@ public:
     /// `moving` walls the shear strain next to a no-slip wall is taken relative to the wall's
     /// velocity, which makes the map affine: use it only for the right-hand side.
     void stiffness(const std::vector<double>& x, std::vector<double>& y,
-                   const WallOptions* moving = nullptr) const {
+                   const BoundaryOptions* moving = nullptr) const {
         y.resize(m_size);
         normal_stresses(x);
         shear_stresses(x, moving);
@@ -125,9 +130,10 @@ public:
                 }
                 Index3 lo = f;
                 --lo[a];
-                double sum =
-                    m_density[flat] +
-                    2.0 * m_dt * (m_mu(lo[0], lo[1], lo[2]) + m_mu(f[0], f[1], f[2])) * inv_dx2;
+                // An outflow face has its cell on one side only.
+                const double mu_lo = f[a] > 0 ? m_mu(lo[0], lo[1], lo[2]) : 0.0;
+                const double mu_hi = f[a] < m_n[a] ? m_mu(f[0], f[1], f[2]) : 0.0;
+                double sum = m_density[flat] + 2.0 * m_dt * (mu_lo + mu_hi) * inv_dx2;
                 for (int b = 0; b < 3; ++b) {
                     if (b == a) {
                         continue;
@@ -185,7 +191,8 @@ public:
     }
 
 private:
-    /// Calls visit(face index, flat index in [u|v|w]) for every interior face of component a.
+    /// Calls visit(face index, flat index in [u|v|w]) for every face of component a that can be
+    /// an unknown: the interior ones and those on an outflow face of the box.
     template <class Visit>
     void for_each_face(int a, Visit&& visit) const {
         const Index3& dims = m_face_dims[a];
@@ -195,7 +202,7 @@ private:
                                   for (int j = 0; j < dims[1]; ++j) {
                                       for (int i = 0; i < dims[0]; ++i) {
                                           const Index3 f = {i, j, k};
-                                          if (f[a] == 0 || f[a] == m_n[a]) {
+                                          if (!solvable(a, f)) {
                                               continue;
                                           }
                                           visit(f, face_flat(a, f));
@@ -203,6 +210,13 @@ private:
                                   }
                               }
                           });
+    }
+
+    /// Is face f of component a inside the box or on one of its outflow faces?
+    bool solvable(int a, const Index3& f) const {
+        if (f[a] == 0)
+            return m_open[a][0];
+        return f[a] != m_n[a] || m_open[a][1];
     }
 
     std::size_t face_flat(int a, const Index3& f) const {
@@ -238,7 +252,7 @@ private:
         }
     }
 
-    void set_edge_weights(const WallOptions& walls, const Array3<double>& phi,
+    void set_edge_weights(const BoundaryOptions& walls, const Array3<double>& phi,
                           const PhaseOptions& phases) {
         for (int c = 0; c < 3; ++c) {
             const int a = (c + 1) % 3;
@@ -254,7 +268,7 @@ private:
                             if (e[axis] == 0 || e[axis] == m_n[axis]) {
                                 fraction *= HALF;  // half the edge's dual cell is outside
                                 const int side = e[axis] == 0 ? 0 : 1;
-                                free_slip |= walls.at(axis, side) == WallType::free_slip;
+                                free_slip |= walls.at(axis, side) == BoundaryType::free_slip;
                             }
                         }
                         if (free_slip) {
@@ -310,8 +324,14 @@ private:
             for_each_face(a, [&](const Index3& f, std::size_t flat) {
                 Index3 lo = f;
                 --lo[a];
+                // An outflow face takes the phase of its one cell.
+                Index3 hi = f;
+                if (f[a] == 0)
+                    lo = hi;
+                if (f[a] == m_n[a])
+                    hi = lo;
                 const double phi_lo = phi(lo[0], lo[1], lo[2]);
-                const double phi_hi = phi(f[0], f[1], f[2]);
+                const double phi_hi = phi(hi[0], hi[1], hi[2]);
                 if (mode == FluidMode::free_surface && !is_liquid(phi_lo) && !is_liquid(phi_hi)) {
                     return;
                 }
@@ -321,6 +341,10 @@ private:
                     mode == FluidMode::free_surface
                         ? phases.rho_liquid * std::max(theta, min_liquid_fraction)
                         : face_density(theta, phases, mode);
+                // An outflow face's control volume is the half cell inside the box, like the
+                // half dual cells of the shear terms on it and the pressure's distance Δx/2.
+                if (f[a] == 0 || f[a] == m_n[a])
+                    m_density[flat] *= OUTFLOW_VOLUME_FRACTION;
             });
         }
     }
@@ -358,14 +382,14 @@ private:
     /// one-sided at walls, where a no-slip wall mirrors the tangential velocity relative to the
     /// wall's own (`moving`, else at rest), with the face indices stepped along each row instead
     /// of recomputed.
-    void shear_stresses(const std::vector<double>& x, const WallOptions* moving) const {
+    void shear_stresses(const std::vector<double>& x, const BoundaryOptions* moving) const {
         for (int c = 0; c < 3; ++c) {
             const int a = (c + 1) % 3;
             const int b = (c + 2) % 3;
             // The walls' velocity components along the derivative's numerator: x_a at the b
             // walls, x_b at the a walls.
             const auto wall = [&](int axis, int side, int component) {
-                return moving ? moving->velocity_at(axis, side)[component] : 0.0;
+                return moving ? moving->face(axis, side).velocity[component] : 0.0;
             };
             const double a_lo = wall(b, 0, a), a_hi = wall(b, 1, a);
             const double b_lo = wall(a, 0, b), b_hi = wall(a, 1, b);
@@ -441,11 +465,21 @@ private:
                             const std::size_t face_row = face_flat(a, {0, j, k});
                             for (int i = 0; i < dims[0]; ++i) {
                                 const Index3 f = {i, j, k};
-                                if (f[a] == 0 || f[a] == m_n[a])
+                                if (!solvable(a, f))
                                     continue;
-                                // Cell f lies above the face, cell f − e_a below it.
-                                const std::size_t cell = sigma.index(i, j, k);
-                                double sum = (sigma[cell - cell_step] - sigma[cell]) * inv_dx;
+                                // Cell f lies above the face, cell f − e_a below it (an outflow
+                                // face has one of them). The flat index of f is formed without
+                                // the array's bounds: on the max face only cell − step is read.
+                                const std::size_t cell =
+                                    static_cast<std::size_t>(i) +
+                                    static_cast<std::size_t>(m_n[0]) *
+                                        (static_cast<std::size_t>(j) +
+                                         static_cast<std::size_t>(m_n[1]) * k);
+                                double sum = 0.0;
+                                if (f[a] > 0)
+                                    sum += sigma[cell - cell_step] * inv_dx;
+                                if (f[a] < m_n[a])
+                                    sum -= sigma[cell] * inv_dx;
                                 for (int t = 0; t < 2; ++t) {
                                     const int b = other[t];
                                     const Array3<double>& tau = m_shear_stress[3 - a - b];
@@ -466,6 +500,7 @@ private:
     }
 
     Index3 m_n{};
+    bool m_open[3][2] = {};  ///< outflow faces of the box: their normal velocity is solved for
     double m_dx = 0.0;
     double m_dt = 0.0;
     std::array<Index3, 3> m_face_dims{};
@@ -504,7 +539,7 @@ struct OperatorKey {
     double dx = 0.0, dt = 0.0, min_liquid_fraction = 0.0;
     double rho_liquid = 0.0, rho_gas = 0.0, mu_liquid = 0.0, mu_gas = 0.0;
     FluidMode mode = FluidMode::two_phase;
-    std::array<WallType, 6> walls{};
+    std::array<BoundaryType, 6> walls{};
     ViscosityWeights weights = ViscosityWeights::sharp;
     /// The surface term, compared by address: held here, so a new one (the caller builds one
     /// for each step) cannot take the old one's address.
@@ -513,7 +548,7 @@ struct OperatorKey {
 
     OperatorKey() = default;
     OperatorKey(const MacGrid& grid, const PhaseOptions& phases,
-                FluidMode mode_in, const WallOptions& walls_in, double dt_in,
+                FluidMode mode_in, const BoundaryOptions& walls_in, double dt_in,
                 double min_fraction, ViscosityWeights weights_in)
         : cells{grid.nx(), grid.ny(), grid.nz()},
           dx(grid.dx()),
@@ -524,8 +559,8 @@ struct OperatorKey {
           mu_liquid(phases.mu_liquid),
           mu_gas(phases.mu_gas),
           mode(mode_in),
-          walls{walls_in.x_min, walls_in.x_max, walls_in.y_min,
-                walls_in.y_max, walls_in.z_min, walls_in.z_max},
+          walls{walls_in.x_min.type, walls_in.x_max.type, walls_in.y_min.type,
+                walls_in.y_max.type, walls_in.z_min.type, walls_in.z_max.type},
           weights(weights_in) {}
 
     /// Equal settings (the stored φ is compared separately, without copying the new one).
@@ -556,7 +591,7 @@ ViscositySolver& ViscositySolver::operator=(ViscositySolver&&) noexcept = defaul
 
 SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interface,
                                    const PhaseOptions& phases, FluidMode mode,
-                                   const WallOptions& walls, double dt,
+                                   const BoundaryOptions& walls, double dt,
                                    const ViscosityOptions& options,
                                    double min_liquid_fraction) {
     options.validate();
@@ -688,7 +723,7 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
 }
 
 SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
-                            const PhaseOptions& phases, FluidMode mode, const WallOptions& walls,
+                            const PhaseOptions& phases, FluidMode mode, const BoundaryOptions& walls,
                             double dt, const ViscosityOptions& options,
                             double min_liquid_fraction) {
     ViscositySolver solver;

@@ -13,10 +13,12 @@
 /// gradients, preconditioned by multigrid V-cycles on each velocity component's own block or by
 /// its diagonal (ViscosityOptions::preconditioner), starting from u* (TBB-parallel operator).
 ///
-/// Boundaries: wall-normal faces keep their stored value. On a no-slip wall the tangential
-/// velocity is mirrored with opposite sign (zero at the wall) and the edge terms on that wall are
-/// weighted by the half of their dual cell inside the box; on a free-slip wall the shear stress
-/// vanishes, so the edge terms lying on that wall are dropped. In free_surface mode only
+/// Boundaries: the normal faces of walls and inflows keep their stored value; those of an outflow
+/// are unknowns with no strain beyond them (zero normal gradient). On a no-slip wall or an
+/// inflow the tangential velocity is mirrored with opposite sign (zero at the face, or the
+/// velocity of a moving wall) and the edge terms on that face are weighted by the half of their
+/// dual cell inside the box; on a free-slip wall or an outflow (zero normal gradient) the shear
+/// stress vanishes, so the edge terms lying on that face are dropped. In free_surface mode only
 /// faces next to a liquid cell are unknowns, the gas has μ = 0, and μ_c and μ_e are μ_liquid
 /// times the liquid fraction of their control volume (a cube of edge Δx around the cell centre
 /// or edge midpoint, clamp(½ − φ/Δx, 0, 1) with φ there; Batty & Bridson 2008), so the surface
@@ -28,6 +30,7 @@
 
 #include <memory>
 
+#include "fluid/boundary.h"
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
 #include "fluid/multigrid.h"
@@ -86,7 +89,7 @@ struct ViscosityOptions {
 /// disabled, or μ = 0 everywhere). Throws std::invalid_argument when `interface` does not fit the
 /// grid or dt ≤ 0. Allocates its work arrays on every call; see ViscositySolver to reuse them.
 SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
-                            const PhaseOptions& phases, FluidMode mode, const WallOptions& walls,
+                            const PhaseOptions& phases, FluidMode mode, const BoundaryOptions& walls,
                             double dt, const ViscosityOptions& options,
                             double min_liquid_fraction = DEFAULT_MIN_LIQUID_FRACTION);
 
@@ -102,7 +105,7 @@ public:
 
     /// See apply_viscosity().
     SolveResult solve(MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,
-                      FluidMode mode, const WallOptions& walls, double dt,
+                      FluidMode mode, const BoundaryOptions& walls, double dt,
                       const ViscosityOptions& options,
                       double min_liquid_fraction = DEFAULT_MIN_LIQUID_FRACTION);
 

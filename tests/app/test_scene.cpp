@@ -198,6 +198,44 @@ TEST(Scene, ErrorsNameTheJsonPath) {
     EXPECT_NE(error_of("[1, 2]").find("/: expected an object"), std::string::npos);
 }
 
+TEST(Scene, BoundariesAreATypeOrAnObjectAndErrorsNameTheFace) {
+    // Issue 39: /fluid/boundaries/<face> is a type name, or an object with the type's data.
+    const Scene s = parse_scene(
+        R"({"surface": {"shape": {"type": "sphere"}}, "fluid": {"boundaries": {
+             "y_min": "no_slip",
+             "y_max": {"type": "no_slip", "velocity": [0.5, 0, 0]},
+             "x_min": {"type": "inflow", "inflow": {"speed": 0.2, "profile": "parabolic",
+                       "region": "disc", "centre": [0, 0.5, 0.5], "radius": 0.1}},
+             "x_max": {"type": "outflow", "pressure": 10}}}})",
+        "t.json", ".");
+    const fluid::BoundaryOptions& b = s.fluid.boundaries;
+    EXPECT_EQ(b.y_min.type, fluid::BoundaryType::no_slip);
+    EXPECT_EQ(b.y_max.velocity.x(), 0.5);
+    EXPECT_EQ(b.x_min.type, fluid::BoundaryType::inflow);
+    EXPECT_EQ(b.x_min.inflow.profile, fluid::InflowProfile::parabolic);
+    EXPECT_EQ(b.x_min.inflow.region, fluid::InflowRegion::disc);
+    EXPECT_EQ(b.x_min.inflow.radius, 0.1);
+    EXPECT_EQ(b.x_max.type, fluid::BoundaryType::outflow);
+    EXPECT_EQ(b.x_max.pressure, 10.0);
+    EXPECT_EQ(b.z_min.type, fluid::BoundaryType::free_slip);
+    const std::string sphere = R"({"surface": {"shape": {"type": "sphere"}}, "fluid": )";
+    EXPECT_NE(error_of(sphere + R"({"boundaries": {"x_min": "open"}}})")
+                  .find("/fluid/boundaries/x_min: expected one of \"free_slip\""),
+              std::string::npos);
+    EXPECT_NE(error_of(sphere + R"({"boundaries": {"x_min": {"type": "inflow", "speeed": 1}}}})")
+                  .find("/fluid/boundaries/x_min/speeed: unknown key"),
+              std::string::npos);
+    EXPECT_NE(error_of(sphere + R"({"boundaries": {"x_min": {"type": "inflow", "inflow": {"speed": 1}}}}})")
+                  .find("inflow without an outflow face"),
+              std::string::npos);
+    EXPECT_NE(error_of(sphere + R"({"boundaries": {"z_max": {"type": "outflow", "velocity": [1, 0, 0]}}}})")
+                  .find("/fluid/boundaries/z_max/velocity: only a no_slip wall"),
+              std::string::npos)
+        << error_of(sphere + R"({"boundaries": {"z_max": {"type": "outflow", "velocity": [1, 0, 0]}}}})");
+    EXPECT_NE(error_of(sphere + R"({"walls": {"x_min": "no_slip"}}})").find("/fluid/walls: unknown key"),
+              std::string::npos);
+}
+
 /// Semi-implicit surface tension: past the capillary limit only with it, and only with the
 /// trilinear vertex velocities it is stable with; each refusal names the field.
 TEST(Scene, ImplicitTensionAndTheCapillaryLimitAreCheckedTogether) {

@@ -199,8 +199,8 @@ TEST(Interpolate, MirrorReflectsTheFlowAcrossFreeSlipWallsAndClampsAtNoSlipOnes)
     Matrix3d gradient;
     gradient << 1.5, -0.4, 2.0, 0.3, -2.5, 0.9, -1.1, 0.6, 1.0;
     set_linear_velocity(grid, Vector3d(0.3, -1.2, 0.7), gradient);
-    fluid::WallOptions walls;  // free-slip but x_max
-    walls.x_max = fluid::WallType::no_slip;
+    fluid::BoundaryOptions walls;  // free-slip but x_max
+    walls.x_max.type = fluid::BoundaryType::no_slip;
     const std::vector<Vector3d> x = {{-0.2, 0.4, 0.45}, {0.5, 0.4, 1.1}, {1.25, 0.9, 0.45}};
     // Where mirroring samples each vertex, and the sign of each component there.
     const std::vector<Vector3d> image = {{0.2, 0.4, 0.45}, {0.5, 0.4, 0.7}, {1.25, 0.7, 0.45}};
@@ -244,8 +244,8 @@ TEST(Interpolate, VertexVelocityWeightsReproduceTheInterpolatedVelocities) {
     for (int axis = 0; axis < 3; ++axis)
         for (double& u : grid.velocity(axis).storage())
             u = value(rng);
-    fluid::WallOptions walls;
-    walls.x_max = fluid::WallType::no_slip;
+    fluid::BoundaryOptions walls;
+    walls.x_max.type = fluid::BoundaryType::no_slip;
     tracker::ImplicitMeshOptions mesher;
     mesher.edge_length = 0.08;
     tracker::SurfaceMesh mesh = tracker::mesh_implicit_shape(

@@ -34,7 +34,7 @@ TEST(FluidSolver, StillWaterStaysStillInBothModes) {
         options.phases.sigma = 0.0;
         options.pressure.iteration.tolerance = 1e-10;
         options.viscosity.iteration.tolerance = 1e-10;
-        options.walls = WallOptions::all(WallType::no_slip);
+        options.boundaries = BoundaryOptions::all(BoundaryType::no_slip);
         const int n = 16;
         FluidSolver solver(n, n, n, 1.0 / n, Eigen::Vector3d::Zero(), options);
         const InterfaceInput interface =

@@ -33,10 +33,10 @@ ChannelErrors channel(int cells_across, double u_bottom, double u_top,
     FluidOptions options;
     options.phases = {RHO, RHO, MU, MU, 0.0};
     options.gravity = Eigen::Vector3d::Zero();
-    options.walls = WallOptions::all(WallType::no_slip);
-    options.walls.z_min = options.walls.z_max = WallType::free_slip;
-    options.walls.y_min_velocity = Eigen::Vector3d(u_bottom, 0.0, 0.0);
-    options.walls.y_max_velocity = Eigen::Vector3d(u_top, 0.0, 0.0);
+    options.boundaries = BoundaryOptions::all(BoundaryType::no_slip);
+    options.boundaries.z_min.type = options.boundaries.z_max.type = BoundaryType::free_slip;
+    options.boundaries.y_min.velocity = Eigen::Vector3d(u_bottom, 0.0, 0.0);
+    options.boundaries.y_max.velocity = Eigen::Vector3d(u_top, 0.0, 0.0);
     options.pressure.iteration.tolerance = 1e-12;
     options.viscosity.iteration.tolerance = 1e-12;
     options.viscosity.iteration.max_iterations = 5000;
@@ -106,27 +106,27 @@ TEST(MovingWalls, LidOverAClosedChannelDrivesTheCouettePoiseuilleReturnFlow) {
 }
 
 TEST(MovingWalls, OptionsNameTheWallThatCannotMove) {
-    WallOptions walls = WallOptions::all(WallType::no_slip);
-    walls.y_max_velocity = Eigen::Vector3d(0.0, 1.0, 0.0);  // along the wall's normal
+    BoundaryOptions walls = BoundaryOptions::all(BoundaryType::no_slip);
+    walls.y_max.velocity = Eigen::Vector3d(0.0, 1.0, 0.0);  // along the wall's normal
     try {
         walls.validate();
         ADD_FAILURE() << "a wall moving along its normal was accepted";
     } catch (const std::invalid_argument& e) {
-        EXPECT_NE(std::string(e.what()).find("y_max_velocity"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("y_max/velocity"), std::string::npos) << e.what();
     }
-    walls.y_max_velocity = Eigen::Vector3d(1.0, 0.0, 0.0);
+    walls.y_max.velocity = Eigen::Vector3d(1.0, 0.0, 0.0);
     EXPECT_NO_THROW(walls.validate());
     EXPECT_TRUE(walls.moving());
     EXPECT_FALSE(walls.at_rest().moving());
-    walls.y_max = WallType::free_slip;
+    walls.y_max.type = BoundaryType::free_slip;
     try {
         walls.validate();
         ADD_FAILURE() << "a moving free-slip wall was accepted";
     } catch (const std::invalid_argument& e) {
-        EXPECT_NE(std::string(e.what()).find("make y_max no_slip"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("y_max/velocity: only a no_slip wall"), std::string::npos) << e.what();
     }
-    walls.y_max = WallType::no_slip;
-    walls.x_min_velocity = Eigen::Vector3d(0.0, NAN, 0.0);
+    walls.y_max.type = BoundaryType::no_slip;
+    walls.x_min.velocity = Eigen::Vector3d(0.0, NAN, 0.0);
     EXPECT_THROW(walls.validate(), std::invalid_argument);
 }
 

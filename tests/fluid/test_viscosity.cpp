@@ -50,9 +50,9 @@ PoiseuilleErrors poiseuille_errors(int cells_across) {
     phases.sigma = 0.0;
     // No-slip everywhere except the z walls: at the inflow and outflow planes this states
     // v = 0 with the shear stress μ ∂u/∂y of the prescribed profile, as in Poiseuille flow.
-    WallOptions walls = WallOptions::all(WallType::no_slip);
-    walls.z_min = WallType::free_slip;
-    walls.z_max = WallType::free_slip;
+    BoundaryOptions walls = BoundaryOptions::all(BoundaryType::no_slip);
+    walls.z_min.type = BoundaryType::free_slip;
+    walls.z_max.type = BoundaryType::free_slip;
     ViscosityOptions viscosity;
     viscosity.iteration.tolerance = 1e-12;
     PressureOptions pressure_options;
@@ -145,9 +145,9 @@ double two_layer_error(int cells_across, ViscosityWeights weights, double offset
     phases.mu_liquid = mu_l;
     phases.mu_gas = mu_g;
     phases.sigma = 0.0;
-    WallOptions walls = WallOptions::all(WallType::no_slip);
-    walls.z_min = WallType::free_slip;
-    walls.z_max = WallType::free_slip;
+    BoundaryOptions walls = BoundaryOptions::all(BoundaryType::no_slip);
+    walls.z_min.type = BoundaryType::free_slip;
+    walls.z_max.type = BoundaryType::free_slip;
     ViscosityOptions viscosity;
     viscosity.iteration.tolerance = 1e-12;
     viscosity.weights = weights;
@@ -216,7 +216,7 @@ TEST(FluidViscosity, RestStaysAtRestWithVariableViscosity) {
     phases.mu_gas = 1e-3;
     for (FluidMode mode : {FluidMode::two_phase, FluidMode::free_surface}) {
         const SolveResult result = apply_viscosity(grid, interface, phases, mode,
-                                                   WallOptions::all(WallType::no_slip), 0.1, {});
+                                                   BoundaryOptions::all(BoundaryType::no_slip), 0.1, {});
         EXPECT_TRUE(result.converged);
         EXPECT_EQ(grid.max_abs_velocity().maxCoeff(), 0.0);
     }
@@ -254,7 +254,7 @@ TEST(FluidViscosity, SurfaceViscosityTermRelaxesTwoCoupledFacesExactly) {
     const double dt = 0.1;
     const double c = dt * term->viscosity / (0.5 * 0.5 * 0.5);
     const SolveResult result = apply_viscosity(grid, interface, phases, FluidMode::two_phase,
-                                               WallOptions::all(WallType::free_slip), dt, options);
+                                               BoundaryOptions::all(BoundaryType::free_slip), dt, options);
     EXPECT_TRUE(result.converged);
     EXPECT_GT(result.iterations, 0);
     const double ua = grid.u()(1, 1, 1), ub = grid.u()(2, 2, 1);
@@ -267,7 +267,7 @@ TEST(FluidViscosity, SurfaceViscosityTermRelaxesTwoCoupledFacesExactly) {
     InterfaceInput wrong(other);
     wrong.surface_viscosity = term;
     EXPECT_THROW(apply_viscosity(other, wrong, phases, FluidMode::two_phase,
-                                 WallOptions::all(WallType::free_slip), dt, options),
+                                 BoundaryOptions::all(BoundaryType::free_slip), dt, options),
                  std::invalid_argument);
 }
 
@@ -299,7 +299,7 @@ TEST(FluidViscosity, TaylorGreenModeIsAnExactDiscreteEigenmode) {
     ViscosityOptions options;
     options.iteration.tolerance = 1e-13;
     const SolveResult result =
-        apply_viscosity(grid, interface, phases, FluidMode::two_phase, WallOptions{}, dt, options);
+        apply_viscosity(grid, interface, phases, FluidMode::two_phase, BoundaryOptions{}, dt, options);
     ASSERT_TRUE(result.converged);
     const double k2 = std::pow(2.0 * std::sin(M_PI * dx / 2.0) / dx, 2);
     const double nu = phases.mu_liquid / phases.rho_liquid;
@@ -327,11 +327,11 @@ TEST(Viscosity, StopsWhenCancelled) {
     ViscosityOptions options;
     options.iteration.cancel = CancellationToken(&stop);
     EXPECT_THROW(apply_viscosity(grid, interface, phases, FluidMode::two_phase,
-                                 WallOptions::all(WallType::no_slip), 0.01, options),
+                                 BoundaryOptions::all(BoundaryType::no_slip), 0.01, options),
                  Cancelled);
     stop = false;
     EXPECT_TRUE(apply_viscosity(grid, interface, phases, FluidMode::two_phase,
-                                WallOptions::all(WallType::no_slip), 0.01, options)
+                                BoundaryOptions::all(BoundaryType::no_slip), 0.01, options)
                     .converged);
 }
 
@@ -359,7 +359,7 @@ TEST(FluidViscosity, ReusedSolverRebuildsForANewInterfaceOrStep) {
     phases.rho_gas = 1.0;
     phases.mu_liquid = 1.0;
     phases.mu_gas = 0.01;
-    const WallOptions walls = WallOptions::all(WallType::no_slip);
+    const BoundaryOptions walls = BoundaryOptions::all(BoundaryType::no_slip);
     ViscosityOptions options;
     options.iteration.tolerance = 1e-10;
     const auto drop = [&](double radius) {
@@ -412,8 +412,8 @@ TEST(FluidViscosity, MultigridPreconditionerGivesTheJacobiAnswerInFewerIteration
     phases.rho_gas = 1.0;
     phases.mu_liquid = 2.0;
     phases.mu_gas = 2e-3;
-    WallOptions walls = WallOptions::all(WallType::no_slip);
-    walls.z_max = WallType::free_slip;
+    BoundaryOptions walls = BoundaryOptions::all(BoundaryType::no_slip);
+    walls.z_max.type = BoundaryType::free_slip;
     const double dt = 10.0 * phases.rho_liquid * dx * dx / phases.mu_liquid;
     for (FluidMode mode : {FluidMode::two_phase, FluidMode::free_surface}) {
         SCOPED_TRACE(mode == FluidMode::two_phase ? "two_phase" : "free_surface");

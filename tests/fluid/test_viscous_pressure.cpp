@@ -38,7 +38,7 @@ InterfaceInput bubble(const MacGrid& grid) {
 FluidOptions options_for(ViscousPressureCoupling coupling) {
     FluidOptions options;
     options.phases = {RHO_LIQUID, RHO_GAS, MU_LIQUID, MU_GAS, 0.0};
-    options.walls = WallOptions::all(WallType::no_slip);
+    options.boundaries = BoundaryOptions::all(BoundaryType::no_slip);
     options.pressure.iteration.tolerance = 1e-12;
     options.viscosity.iteration.tolerance = 1e-12;
     options.viscosity.iteration.max_iterations = 5000;
