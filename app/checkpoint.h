@@ -20,7 +20,7 @@ namespace meniscus::app {
 /// The checkpoint's file name in the output folder.
 constexpr const char* CHECKPOINT_NAME = "checkpoint.bin";
 /// Bumped whenever the layout or the meaning of a saved field changes.
-constexpr std::uint32_t CHECKPOINT_VERSION = 1;
+constexpr std::uint32_t CHECKPOINT_VERSION = 2;  ///< 2: volumes through the open faces
 
 /// What the run records beside the solver state.
 struct CheckpointHeader {

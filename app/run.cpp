@@ -232,6 +232,49 @@ struct FrameSolves {
     }
 };
 
+/// What a frame's steps did at the open faces of the box (inflow and outflow).
+struct FrameOpenBoundaries {
+    coupling::BoundaryVolumes volumes;
+    int clips = 0, components_removed = 0, deferred_clips = 0, unfed_inflows = 0;
+    std::string deferred;
+
+    void add(const coupling::OpenBoundaryReport& r) {
+        volumes += r.volumes;
+        clips += r.clips;
+        components_removed += r.components_removed;
+        deferred_clips += r.deferred_clips;
+        unfed_inflows += r.unfed_inflows;
+        if (!r.deferred.empty())
+            deferred = r.deferred;
+    }
+
+    /// stats.jsonl "open_boundaries": this frame's volumes in and out by phase (m³), the run's
+    /// totals, the clips and the components that left whole.
+    nlohmann::json json(const coupling::BoundaryVolumes& total) const {
+        const auto figures = [](const coupling::BoundaryVolumes& v) {
+            return nlohmann::json{{"liquid_in", v.liquid_in},
+                                  {"gas_in", v.gas_in},
+                                  {"liquid_out", v.liquid_out},
+                                  {"gas_out", v.gas_out}};
+        };
+        return {{"frame", figures(volumes)},
+                {"total", figures(total)},
+                {"clips", clips},
+                {"components_removed", components_removed},
+                {"deferred_clips", deferred_clips},
+                {"unfed_inflow_steps", unfed_inflows}};
+    }
+
+    /// The run-log warning when cuts at outflow faces had to wait ("" otherwise).
+    std::string warning(int frame) const {
+        if (deferred_clips == 0)
+            return "";
+        return "warning: frame " + std::to_string(frame) + ": the mesh could not be cut at an " +
+               "outflow face in " + std::to_string(deferred_clips) + " steps (" + deferred +
+               "); what reaches past it stays until a later cut";
+    }
+};
+
 nlohmann::json fluid_frame_stats(int frame, double time, long long steps,
                                  const coupling::Simulation& sim,
                                  const coupling::SimulationStepReport& last,
@@ -449,11 +492,13 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
         FluidFrameTimes times;
         long long intersecting = -1, merges = 0, splits = 0, shortenings = 0;
         FrameSolves solves;
+        FrameOpenBoundaries open_faces;
         while (t < t_frame) {
             if (should_stop(options, stop, t, progress, result))
                 return;
             last = sim.step(t_frame - t, scene.time.dt);
             solves.add(last.fluid);
+            open_faces.add(last.open_boundaries);
             times.add(last);
             intersecting = std::max<long long>(intersecting, last.integrate.intersecting_pairs);
             result.max_intersecting_pairs =
@@ -468,12 +513,20 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
         PhaseClock output_clock;
         writer.write(frame, sim.tracker().mesh(), sim.vertex_velocities(), fields());
         output_clock.lap_into(times.output);
-        nlohmann::json line = fluid_frame_stats(frame, t, steps, sim, last, times.json(),
-                                                {{"intersecting_pairs", intersecting},
-                                                 {"merges", merges},
-                                                 {"splits", splits},
-                                                 {"step_shortenings", shortenings},
-                                                 {"solves", solves.json(steps)}});
+        nlohmann::json work = {{"intersecting_pairs", intersecting},
+                               {"merges", merges},
+                               {"splits", splits},
+                               {"step_shortenings", shortenings},
+                               {"solves", solves.json(steps)}};
+        const fluid::BoundaryOptions& boundaries = sim.fluid().options().boundaries;
+        if (boundaries.open() || boundaries.inflow())
+            work["open_boundaries"] = open_faces.json(sim.boundary_volumes());
+        nlohmann::json line = fluid_frame_stats(frame, t, steps, sim, last, times.json(), work);
+        const std::string deferred = open_faces.warning(frame);
+        if (!deferred.empty() && !options.quiet) {
+            progress.finish();
+            std::fprintf(stderr, "%s\n", deferred.c_str());
+        }
         checkpointer.write(frame, t, result, 0.0, 0, line, writer, save);
         writer.stats(line);
         const std::string warning = solves.warning(frame, steps);

@@ -207,6 +207,12 @@ void visit_fields(V& v, CouplingOptions& o) {
                 {"mirror", coupling::OutsideVelocity::mirror}},
                "velocity of mesh vertices outside the domain: clamp (that of the nearest point "
                "inside) or mirror (across free-slip walls, the reflected flow)");
+    v.number("outflow_clip_near_cells", o.simulation.open_boundaries.clip_near_cells,
+             Range::non_negative(), "cells",
+             "the mesh beyond an outflow face is cut off between this many cells beyond the face "
+             "and outflow_clip_far_cells (where the vertices leave most room)");
+    v.number("outflow_clip_far_cells", o.simulation.open_boundaries.clip_far_cells,
+             Range::positive(), "cells", "the far end of that range (> outflow_clip_near_cells)");
     v.number("capillary_safety", o.simulation.capillary_safety,
              Range{0.0, coupling::MAX_IMPLICIT_CAPILLARY_SAFETY, true, false}, "",
              "factor on the capillary time-step limit (above 1 only with implicit_tension)");

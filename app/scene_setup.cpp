@@ -3,6 +3,8 @@
 #include "app/errors.h"
 #include "app/resource_estimate.h"
 #include "app/surface_checks.h"
+#include "coupling/mesh_band.h"
+#include "fluid/boundary.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/mesh_intersections.h"
 #include "tracker/mesh_io.h"
@@ -146,6 +148,40 @@ void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::M
     }
 }
 
+/// Each inflow lets in the phase the surface puts at its region's centre, half a cell inside
+/// the box (a jet's or bubble's surface must reach through the face, or the box hold that phase
+/// around the face). Throws InputError naming the inflow's phase otherwise.
+void check_inflow_phases(const Scene& scene, const SurfaceMesh& mesh, const fluid::MacGrid& grid) {
+    static const char* const faces[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"},
+                                            {"z_min", "z_max"}};
+    const Vec3 lo = grid.origin();
+    const Vec3 hi = lo + grid.dx() * Vec3(grid.nx(), grid.ny(), grid.nz());
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side) {
+            const fluid::FaceBoundary& face = scene.fluid.boundaries.face(axis, side);
+            if (face.type != fluid::BoundaryType::inflow || face.inflow.speed == 0.0)
+                continue;
+            Vec3 centre = face.inflow.region == fluid::InflowRegion::disc ? face.inflow.centre
+                                                                          : Vec3(0.5 * (lo + hi));
+            centre[axis] = side == 0 ? lo[axis] + 0.5 * grid.dx() : hi[axis] - 0.5 * grid.dx();
+            const int liquid = scene.coupling.simulation.rasterize.liquid_region;
+            const bool liquid_there =
+                coupling::region_at(mesh, centre, 0) == liquid;
+            const bool liquid_in = face.inflow.phase == fluid::InflowPhase::liquid;
+            if (liquid_there == liquid_in)
+                continue;
+            std::ostringstream s;
+            s << scene.source_path << ": /fluid/boundaries/" << faces[axis][side]
+              << "/inflow/phase: the inflow lets in " << (liquid_in ? "liquid" : "gas")
+              << ", but the surface puts " << (liquid_there ? "liquid" : "gas") << " at ("
+              << centre.x() << ", " << centre.y() << ", " << centre.z()
+              << "), the middle of the inflow region half a cell inside the box; the "
+              << (liquid_in ? "jet's" : "bubble's")
+              << " surface must reach through the face (the part behind it is the nozzle)";
+            throw InputError(s.str());
+        }
+}
+
 }  // namespace
 
 tracker::TrackerOptions tracker_options(const Scene& scene, double nominal_xi) {
@@ -218,6 +254,8 @@ coupling::Simulation make_fluid_simulation(const Scene& scene, SurfaceMesh initi
                               cells_along(scene.domain.size.z(), "/domain/size/2"), dx,
                               scene.domain.min, options);
     apply_initial_velocity(scene.initial_velocity, solver.grid(), scene.cancel);
+    fluid::apply_boundary_velocity(solver.grid(), options.boundaries);  // regions may reach faces
+    check_inflow_phases(scene, initial, solver.grid());
     return coupling::Simulation(
         tracker::SurfaceTracker(std::move(initial), tracker_options(scene, nominal_xi)),
         std::move(solver), scene.coupling.simulation);

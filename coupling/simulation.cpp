@@ -23,6 +23,7 @@ void SimulationOptions::validate() const {
     rasterize.validate();
     surface_tension.validate();
     interpolate.validate();
+    open_boundaries.validate();
     if (!(implicit_tension >= 0.0 && implicit_tension <= 1.0))
         throw std::invalid_argument("implicit_tension: expected a number in [0, 1]");
     if (implicit_tension > 0.0 && interpolate.method != VelocityInterpolation::trilinear)
@@ -74,7 +75,9 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     // (1) Time step.
     const fluid::TimeStepLimits limits = m_fluid.time_step_limits();
     const fluid::PhaseOptions& phases = m_fluid.options().phases;
-    const double h = std::min(grid.dx(), tracker::edge_length_stats(mesh).mean);
+    // (An empty mesh — everything left through outflow faces — has no edge length.)
+    const tracker::EdgeLengthStats edges = tracker::edge_length_stats(mesh);
+    const double h = edges.count > 0 ? std::min(grid.dx(), edges.mean) : grid.dx();
     const double rho_mean = m_fluid.options().mode == fluid::FluidMode::two_phase
                                 ? 0.5 * (phases.rho_liquid + phases.rho_gas)
                                 : 0.5 * phases.rho_liquid;
@@ -119,7 +122,16 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
         m_volumes->begin_step();
         clock.lap_into(timings.volume_correction);
     }
-    report.improve = m_tracker->improve();
+    // The nozzle's mesh behind an inflow face stays where it is (open_boundaries.h).
+    const fluid::BoundaryOptions& boundaries = m_fluid.options().boundaries;
+    std::vector<std::uint8_t> held;
+    if (boundaries.inflow())
+        held = held_vertices(mesh, grid, boundaries);
+    report.improve = m_tracker->improve(held.empty() ? nullptr : &held);
+    report.open_boundaries = apply_open_boundaries(mesh, grid, boundaries, report.dt,
+                                                   m_options.rasterize.liquid_region,
+                                                   m_options.open_boundaries, m_volumes.get());
+    m_boundary_volumes += report.open_boundaries.volumes;
     report.topology = m_tracker->change_topology();  // compacts
     clock.lap_into(timings.tracker);
     if (m_volumes) {
@@ -129,8 +141,13 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
 
     // (4) Grid → mesh.
     m_vertex_velocities =
-        interpolate_vertex_velocities(m_fluid.grid(), mesh, m_options.interpolate,
-                                      m_fluid.options().boundaries);
+        interpolate_vertex_velocities(m_fluid.grid(), mesh, m_options.interpolate, boundaries);
+    if (boundaries.inflow())
+        held = held_vertices(mesh, grid, boundaries);  // renumbered since
+    for (size_t v = 0; v < held.size(); ++v)
+        if (held[v])
+            m_vertex_velocities[v] = tracker::Vec3::Zero();
+    const std::vector<std::uint8_t>* pinned = held.empty() ? nullptr : &held;
     for (const tracker::Vec3& v : m_vertex_velocities)
         report.max_vertex_speed = std::max(report.max_vertex_speed, v.norm());
     clock.lap_into(timings.interpolate);
@@ -140,10 +157,10 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     add_subgrid_tension(velocities, report.dt);
     clock.lap_into(timings.curvature);
     if (m_volumes) {
-        m_volumes->add_correction(velocities, report.dt);
+        m_volumes->add_correction(velocities, report.dt, pinned);
         clock.lap_into(timings.volume_correction);
     }
-    report.integrate = m_tracker->integrate(velocities, report.dt);
+    report.integrate = m_tracker->integrate(velocities, report.dt, pinned);
     clock.lap_into(timings.tracker);
     for (const PhaseSeconds* phase : {&timings.rasterize, &timings.curvature, &timings.fluid,
                                       &timings.interpolate, &timings.volume_correction,
@@ -228,6 +245,9 @@ void Simulation::save_state(BinaryWriter& out) const {
     out.put<std::uint8_t>(m_phi.size() > 0 ? 1 : 0);
     if (m_phi.size() > 0)
         fluid::save_array(out, m_phi);
+    for (double v : {m_boundary_volumes.liquid_in, m_boundary_volumes.gas_in,
+                     m_boundary_volumes.liquid_out, m_boundary_volumes.gas_out})
+        out.put(v);
 }
 
 void Simulation::load_state(BinaryReader& in) {
@@ -252,8 +272,15 @@ void Simulation::load_state(BinaryReader& in) {
         phi.resize(g.nx(), g.ny(), g.nz());
         fluid::load_array(in, phi, "simulation state: phi");
     }
+    BoundaryVolumes through;
+    for (double* v : {&through.liquid_in, &through.gas_in, &through.liquid_out, &through.gas_out}) {
+        *v = in.get<double>();
+        if (!std::isfinite(*v) || *v < 0.0)
+            throw FormatError("simulation state: a volume through the open faces is not >= 0");
+    }
     m_vertex_velocities = std::move(velocities);
     m_phi = std::move(phi);
+    m_boundary_volumes = through;
     m_time = time;
 }
 

@@ -5,10 +5,13 @@
 /// (3) the fluid step; (4) grid velocity → mesh vertices, plus the sub-grid surface-tension
 /// velocity that damps mesh-scale wrinkles (subgrid_tension_velocities()); (5) the tracker's
 /// improve(), change_topology() and collision-safe integrate(); (6) optional volume correction per
-/// connected component (through merges and pinch-offs).
+/// connected component (through merges and pinch-offs). At open faces of the box the mesh is held
+/// behind inflows and clipped beyond outflows, and the volume correction's targets follow what
+/// entered and left (open_boundaries.h).
 
 #include "common/phase_clock.h"
 #include "coupling/interpolate.h"
+#include "coupling/open_boundaries.h"
 #include "coupling/rasterize.h"
 #include "coupling/surface_tension.h"
 #include "coupling/volume_correction.h"
@@ -30,6 +33,7 @@ struct SimulationOptions {
     RasterizeOptions rasterize;
     SurfaceTensionOptions surface_tension;
     InterpolateOptions interpolate;
+    OpenBoundaryOptions open_boundaries;  ///< the mesh at inflow and outflow faces
     bool volume_correction = true;  ///< restore each component's volume every step
     /// Safety factor on the capillary limit sqrt(ρ̄ h³ / (2πσ)), h = min(Δx, mean edge): in (0, 1]
     /// with explicit surface tension, up to MAX_IMPLICIT_CAPILLARY_SAFETY with implicit_tension.
@@ -86,6 +90,7 @@ struct SimulationStepReport {
     tracker::ImproveReport improve;
     tracker::TopologyReport topology;
     VolumeReport volume;
+    OpenBoundaryReport open_boundaries;  ///< mesh clipped at outflow faces, volume let in
     double max_vertex_speed = 0.0;  ///< m/s, interpolated
     SimulationTimings timings;
 };
@@ -112,9 +117,12 @@ public:
     const std::vector<tracker::Vec3>& vertex_velocities() const { return m_vertex_velocities; }
     /// Kinetic energy ½ Σ ρ u² dV over the grid's faces (J), liquid and gas by φ.
     double kinetic_energy() const;
+    /// Volumes that entered through inflow faces and were clipped off at outflow faces since the
+    /// start of the run (m³; kept in the state).
+    const BoundaryVolumes& boundary_volumes() const { return m_boundary_volumes; }
 
     /// Exact state for checkpoints: time, tracker, fluid, volume targets, the last vertex
-    /// velocities and φ; a Simulation built from the same scene and given this state steps
+    /// velocities, φ and the volumes through the open faces; a Simulation built from the same scene and given this state steps
     /// exactly as this one would. load_state() throws FormatError on truncated or mismatched
     /// data (then the simulation must not be stepped).
     void save_state(BinaryWriter& out) const;
@@ -131,6 +139,7 @@ private:
     std::unique_ptr<VolumeTracker> m_volumes;
     std::vector<tracker::Vec3> m_vertex_velocities;
     fluid::Array3<double> m_phi;  ///< φ of the last step, for the kinetic energy
+    BoundaryVolumes m_boundary_volumes;
     double m_time = 0.0;
 };
 

@@ -115,11 +115,42 @@ VolumeReport VolumeTracker::match_components() {
     return report;
 }
 
-double VolumeTracker::add_correction(std::vector<Vec3>& velocities, double dt) const {
+bool VolumeTracker::add_to_target(int vi, double delta) {
+    const auto known = [&](int v) {
+        return static_cast<size_t>(v) < m_vertex_component.size() &&
+               m_vertex_component[static_cast<size_t>(v)] >= 0 &&
+               static_cast<size_t>(m_vertex_component[static_cast<size_t>(v)]) <
+                   m_old_targets.size();
+    };
+    if (vi < 0 || vi >= m_mesh.num_vertices() || !m_mesh.vertex_alive(vi))
+        return false;
+    // Breadth first over edges to the nearest vertex that existed at begin_step().
+    std::vector<int> queue = {vi};
+    std::set<int> seen = {vi};
+    for (size_t head = 0; head < queue.size(); ++head) {
+        const int v = queue[head];
+        if (known(v)) {
+            m_old_targets[static_cast<size_t>(m_vertex_component[static_cast<size_t>(v)])] += delta;
+            return true;
+        }
+        for (int ei : m_mesh.vertex_edges(v)) {
+            const int w = m_mesh.other_vertex(ei, v);
+            if (seen.insert(w).second)
+                queue.push_back(w);
+        }
+    }
+    return false;
+}
+
+double VolumeTracker::add_correction(std::vector<Vec3>& velocities, double dt,
+                                     const std::vector<std::uint8_t>* held) const {
     if (!(dt > 0.0))
         throw std::invalid_argument("add_correction: dt must be > 0");
     if (velocities.size() != static_cast<size_t>(m_mesh.num_vertices()))
         throw std::invalid_argument("add_correction: velocities must be sized num_vertices()");
+    if (held && held->size() != velocities.size())
+        throw std::invalid_argument("add_correction: held must be sized num_vertices()");
+    const auto is_held = [&](size_t v) { return held && (*held)[v]; };
     const size_t nc = m_targets.size();
     std::vector<double> volume(nc, 0.0), area(nc, 0.0);
     std::vector<Vec3> normal(static_cast<size_t>(m_mesh.num_vertices()), Vec3::Zero());
@@ -151,6 +182,8 @@ double VolumeTracker::add_correction(std::vector<Vec3>& velocities, double dt) c
         const int comp =
             c.triangle_component[static_cast<size_t>(m_mesh.vertex_triangles(vi).front())];
         vertex_component[v] = comp;
+        if (is_held(v))
+            continue;  // does not move: adds no rate, takes no correction
         rate[static_cast<size_t>(comp)] += velocities[v].dot(normal[v]) / 6.0;
         rate_per_speed[static_cast<size_t>(comp)] += normal[v].norm() / 6.0;
     }
@@ -158,7 +191,7 @@ double VolumeTracker::add_correction(std::vector<Vec3>& velocities, double dt) c
     for (int vi = 0; vi < m_mesh.num_vertices(); ++vi) {
         const size_t v = static_cast<size_t>(vi);
         const int comp = vertex_component[v];
-        if (comp < 0)
+        if (comp < 0 || is_held(v))
             continue;
         const size_t ci = static_cast<size_t>(comp);
         const double n = normal[v].norm();

@@ -20,6 +20,7 @@
 
 #include "tracker/mesh.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace meniscus::coupling {
@@ -48,10 +49,19 @@ public:
     /// Call after the mesh changes of the step (topology, compaction) and before computing the
     /// correction: matches components and updates targets.
     VolumeReport match_components();
+    /// Between begin_step() and match_components(): the target of the component vertex `vi`
+    /// belonged to at begin_step() changes by `delta` (m³, with the sign of its enclosed volume):
+    /// volume that entered through an inflow face or was clipped off at an outflow face. A vertex
+    /// created since begin_step() stands for the first vertex it is connected to that existed
+    /// then. Returns false (and changes nothing) when no such vertex is found.
+    bool add_to_target(int vi, double delta);
     /// Adds the correction velocity (see file comment) to `velocities` (sized num_vertices()),
-    /// which must already hold the step's motion. `dt` > 0 (s). Returns the largest correction
-    /// displacement applied (m).
-    double add_correction(std::vector<tracker::Vec3>& velocities, double dt) const;
+    /// which must already hold the step's motion. `dt` > 0 (s). `held` (optional, sized
+    /// num_vertices()): vertices that do not move (integrate()'s pinned ones) take no
+    /// correction, the others of their component make up for them. Returns the largest
+    /// correction displacement applied (m).
+    double add_correction(std::vector<tracker::Vec3>& velocities, double dt,
+                          const std::vector<std::uint8_t>* held = nullptr) const;
 
     /// Targets of the current components (after match_components()).
     const std::vector<double>& targets() const { return m_targets; }
