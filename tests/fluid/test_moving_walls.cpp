@@ -10,13 +10,13 @@
 #include <stdexcept>
 
 #include "fluid/fluid_solver.h"
+#include "steady_channel.h"
 
 namespace meniscus::fluid {
 namespace {
 
-constexpr double HEIGHT = 1.0;  ///< H, m
-constexpr double RHO = 1000.0;
-constexpr double MU = 1000.0;   ///< ν = 1 m²/s
+constexpr double HEIGHT = testing::CHANNEL_HEIGHT;  ///< H, m
+constexpr double MU = testing::CHANNEL_MU;          ///< ν = 1 m²/s
 constexpr double SPEED = 0.01;  ///< U, m/s: Re = U H / ν = 0.01, Stokes flow
 constexpr int LENGTH = 8;       ///< channel length in H
 
@@ -31,31 +31,13 @@ struct ChannelErrors {
 ChannelErrors channel(int cells_across, double u_bottom, double u_top,
                       const std::function<double(double)>& exact) {
     FluidOptions options;
-    options.phases = {RHO, RHO, MU, MU, 0.0};
-    options.gravity = Eigen::Vector3d::Zero();
     options.boundaries = BoundaryOptions::all(BoundaryType::no_slip);
     options.boundaries.z_min.type = options.boundaries.z_max.type = BoundaryType::free_slip;
     options.boundaries.y_min.velocity = Eigen::Vector3d(u_bottom, 0.0, 0.0);
     options.boundaries.y_max.velocity = Eigen::Vector3d(u_top, 0.0, 0.0);
-    options.pressure.iteration.tolerance = 1e-12;
-    options.viscosity.iteration.tolerance = 1e-12;
-    options.viscosity.iteration.max_iterations = 5000;
-    options.viscous_pressure.max_passes = 30;
-    options.viscous_pressure.pass_tolerance = 1e-10;
     const double dx = HEIGHT / cells_across;
     const int nx = LENGTH * cells_across;
-    FluidSolver solver(nx, cells_across, 1, dx, Eigen::Vector3d::Zero(), options);
-    const InterfaceInput interface(solver.grid());  // all liquid
-    const double dt = 0.5 * HEIGHT * HEIGHT * RHO / MU;  // the coupled scheme is steady at any Δt
-    bool steady = false;
-    for (int step = 0; step < 400 && !steady; ++step) {
-        const MacGrid before = solver.grid();
-        const StepResult r = solver.step(dt, interface);
-        EXPECT_TRUE(r.pressure.converged);
-        EXPECT_TRUE(r.viscosity.converged);
-        steady = step > 2 && max_velocity_difference(before, solver.grid()) <= 1e-10 * SPEED;
-    }
-    EXPECT_TRUE(steady) << "no steady state at " << cells_across << " cells across";
+    const FluidSolver solver = testing::steady_channel(options, cells_across, LENGTH, SPEED);
     ChannelErrors errors;
     const MacGrid& grid = solver.grid();
     for (int j = 0; j < cells_across; ++j) {
