@@ -249,8 +249,15 @@ struct FrameOpenBoundaries {
     }
 
     /// stats.jsonl "open_boundaries": this frame's volumes in and out by phase (m³), the run's
-    /// totals, the clips and the components that left whole.
-    nlohmann::json json(const coupling::BoundaryVolumes& total) const {
+    /// totals, the clips, the components that left whole, and per inflow face how far the part of
+    /// the mesh it feeds reaches into the box (a jet's intact length, m).
+    nlohmann::json json(const coupling::BoundaryVolumes& total,
+                        const std::vector<coupling::InflowAttachment>& inflows) const {
+        static const char* const faces[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"},
+                                                {"z_min", "z_max"}};
+        nlohmann::json attached = nlohmann::json::array();
+        for (const coupling::InflowAttachment& a : inflows)
+            attached.push_back({{"face", faces[a.axis][a.side]}, {"attached_reach", a.reach}});
         const auto figures = [](const coupling::BoundaryVolumes& v) {
             return nlohmann::json{{"liquid_in", v.liquid_in},
                                   {"gas_in", v.gas_in},
@@ -262,7 +269,8 @@ struct FrameOpenBoundaries {
                 {"clips", clips},
                 {"components_removed", components_removed},
                 {"deferred_clips", deferred_clips},
-                {"unfed_inflow_steps", unfed_inflows}};
+                {"unfed_inflow_steps", unfed_inflows},
+                {"inflows", attached}};
     }
 
     /// The run-log warning when cuts at outflow faces had to wait ("" otherwise).
@@ -520,7 +528,9 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
                                {"solves", solves.json(steps)}};
         const fluid::BoundaryOptions& boundaries = sim.fluid().options().boundaries;
         if (boundaries.open() || boundaries.inflow())
-            work["open_boundaries"] = open_faces.json(sim.boundary_volumes());
+            work["open_boundaries"] = open_faces.json(
+                sim.boundary_volumes(),
+                coupling::inflow_attachments(sim.tracker().mesh(), sim.fluid().grid(), boundaries));
         nlohmann::json line = fluid_frame_stats(frame, t, steps, sim, last, times.json(), work);
         const std::string deferred = open_faces.warning(frame);
         if (!deferred.empty() && !options.quiet) {

@@ -68,6 +68,56 @@ std::vector<std::uint8_t> held_vertices(const tracker::SurfaceMesh& mesh, const 
     return held;
 }
 
+std::vector<InflowAttachment> inflow_attachments(const tracker::SurfaceMesh& mesh,
+                                                 const fluid::MacGrid& grid,
+                                                 const fluid::BoundaryOptions& boundaries) {
+    std::vector<InflowAttachment> attached;
+    const Box box(grid);
+    tracker::Components components;
+    std::vector<double> volumes;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side) {
+            const fluid::FaceBoundary& face = boundaries.face(axis, side);
+            if (face.type != fluid::BoundaryType::inflow)
+                continue;
+            InflowAttachment a;
+            a.axis = axis;
+            a.side = side;
+            // The vertex behind the face nearest the inflow region's centre names the component.
+            const Eigen::Vector3d centre = inflow_centre(face, box, axis, side);
+            double best = std::numeric_limits<double>::infinity();
+            for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+                if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty() ||
+                    !box.beyond(mesh.position(vi), axis, side))
+                    continue;
+                Eigen::Vector3d offset = mesh.position(vi) - centre;
+                offset[axis] = 0.0;
+                if (offset.squaredNorm() < best) {
+                    best = offset.squaredNorm();
+                    a.vertex = vi;
+                }
+            }
+            if (a.vertex != tracker::INVALID_INDEX) {
+                if (components.count == 0) {
+                    components = tracker::triangle_components(mesh);
+                    volumes = tracker::component_volumes(mesh, components);
+                }
+                const int ti = mesh.vertex_triangles(a.vertex).front();
+                const int comp = components.triangle_component[static_cast<size_t>(ti)];
+                a.labels = mesh.labels(ti);
+                a.volume = volumes[static_cast<size_t>(comp)];
+                const double inward = side == 0 ? 1.0 : -1.0;
+                for (int tj = 0; tj < mesh.num_triangles(); ++tj)
+                    if (mesh.triangle_alive(tj) &&
+                        components.triangle_component[static_cast<size_t>(tj)] == comp)
+                        for (int v : mesh.triangle(tj))
+                            a.reach = std::max(a.reach, inward * (mesh.position(v)[axis] - centre[axis]));
+            }
+            attached.push_back(a);
+        }
+    return attached;
+}
+
 OpenBoundaryReport apply_open_boundaries(tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
                                          const fluid::BoundaryOptions& boundaries, double dt,
                                          int liquid_region, const OpenBoundaryOptions& options,
@@ -80,43 +130,23 @@ OpenBoundaryReport apply_open_boundaries(tracker::SurfaceMesh& mesh, const fluid
     const double dx = grid.dx();
 
     // Inflow: the volume of the step goes to the component behind the face.
-    for (int axis = 0; axis < 3; ++axis)
-        for (int side = 0; side < 2; ++side) {
-            const fluid::FaceBoundary& face = boundaries.face(axis, side);
-            if (face.type != fluid::BoundaryType::inflow || face.inflow.speed == 0.0)
-                continue;
-            const double entered = fluid::inflow_volume_rate(grid, boundaries, axis, side) * dt;
-            const bool liquid = face.inflow.phase == fluid::InflowPhase::liquid;
-            count(report.volumes, true, liquid, entered);
-            if (!volumes)
-                continue;
-            // The vertex behind the face nearest the inflow region's centre names the component.
-            const Eigen::Vector3d centre = inflow_centre(face, box, axis, side);
-            int nearest = tracker::INVALID_INDEX;
-            double best = std::numeric_limits<double>::infinity();
-            for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
-                if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty() ||
-                    !box.beyond(mesh.position(vi), axis, side))
-                    continue;
-                Eigen::Vector3d offset = mesh.position(vi) - centre;
-                offset[axis] = 0.0;
-                if (offset.squaredNorm() < best) {
-                    best = offset.squaredNorm();
-                    nearest = vi;
-                }
-            }
-            bool fed = false;
-            if (nearest != tracker::INVALID_INDEX) {
-                const tracker::Components components = tracker::triangle_components(mesh);
-                const int ti = mesh.vertex_triangles(nearest).front();
-                const int comp = components.triangle_component[static_cast<size_t>(ti)];
-                const double volume =
-                    tracker::component_volumes(mesh, components)[static_cast<size_t>(comp)];
-                if ((enclosed_region(mesh.labels(ti), volume) == liquid_region) == liquid)
-                    fed = volumes->add_to_target(nearest, volume >= 0.0 ? entered : -entered);
-            }
-            report.unfed_inflows += fed ? 0 : 1;
-        }
+    const std::vector<InflowAttachment> attached =
+        boundaries.inflow() ? inflow_attachments(mesh, grid, boundaries)
+                            : std::vector<InflowAttachment>{};
+    for (const InflowAttachment& a : attached) {
+        const fluid::FaceBoundary& face = boundaries.face(a.axis, a.side);
+        if (face.inflow.speed == 0.0)
+            continue;
+        const double entered = fluid::inflow_volume_rate(grid, boundaries, a.axis, a.side) * dt;
+        const bool liquid = face.inflow.phase == fluid::InflowPhase::liquid;
+        count(report.volumes, true, liquid, entered);
+        if (!volumes)
+            continue;
+        const bool fed = a.vertex != tracker::INVALID_INDEX &&
+                         (enclosed_region(a.labels, a.volume) == liquid_region) == liquid &&
+                         volumes->add_to_target(a.vertex, a.volume >= 0.0 ? entered : -entered);
+        report.unfed_inflows += fed ? 0 : 1;
+    }
 
     // Outflow: clip beyond the face; the removed volume leaves its component's target.
     for (int axis = 0; axis < 3; ++axis)

@@ -66,6 +66,24 @@ struct OpenBoundaryReport {
     int unfed_inflows = 0;
 };
 
+/// The part of the mesh an inflow face feeds: the component reaching behind the face nearest the
+/// centre of the inflow region (the jet, or the bubble growing at its orifice).
+struct InflowAttachment {
+    int axis = 0;
+    int side = 0;
+    int vertex = tracker::INVALID_INDEX;  ///< one of its vertices behind the face; none: INVALID
+    /// Farthest distance (m) of its vertices from the face into the box: the length of a jet
+    /// still attached to its nozzle (0 when none).
+    double reach = 0.0;
+    tracker::LabelPair labels;  ///< of its triangles
+    double volume = 0.0;        ///< its signed enclosed volume (m³)
+};
+
+/// One entry per inflow face of `boundaries`, in axis and side order.
+std::vector<InflowAttachment> inflow_attachments(const tracker::SurfaceMesh& mesh,
+                                                 const fluid::MacGrid& grid,
+                                                 const fluid::BoundaryOptions& boundaries);
+
 /// 1 for every live vertex beyond an inflow face of the box (the nozzle's part of the mesh,
 /// which the fluid does not move), 0 elsewhere; sized mesh.num_vertices().
 std::vector<std::uint8_t> held_vertices(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
