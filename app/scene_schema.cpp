@@ -56,6 +56,11 @@ void visit_fields(V& v, fluid::FaceBoundary& o) {
     v.section("inflow", "inflow: what flows in, where and how fast", [&](auto& r) {
         r.number("speed", o.inflow.speed, Range::non_negative(), "m/s",
                  "mean normal speed into the box over the region");
+        r.number("pulse", o.inflow.pulse, Range{0.0, 1.0, false, true}, "",
+                 "relative amplitude ε of a modulation of the speed, speed·(1 + ε sin 2πft): a "
+                 "forced jet (0 = steady)");
+        r.number("pulse_frequency", o.inflow.pulse_frequency, Range::non_negative(), "Hz",
+                 "f of that modulation");
         enum_field(r, "profile", o.inflow.profile,
                    {{"uniform", fluid::InflowProfile::uniform},
                     {"parabolic", fluid::InflowProfile::parabolic}},

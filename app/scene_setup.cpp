@@ -254,7 +254,8 @@ coupling::Simulation make_fluid_simulation(const Scene& scene, SurfaceMesh initi
                               cells_along(scene.domain.size.z(), "/domain/size/2"), dx,
                               scene.domain.min, options);
     apply_initial_velocity(scene.initial_velocity, solver.grid(), scene.cancel);
-    fluid::apply_boundary_velocity(solver.grid(), options.boundaries);  // regions may reach faces
+    // The velocity regions may have reached the box's faces.
+    fluid::apply_boundary_velocity(solver.grid(), options.boundaries, solver.time());
     check_inflow_phases(scene, initial, solver.grid());
     return coupling::Simulation(
         tracker::SurfaceTracker(std::move(initial), tracker_options(scene, nominal_xi)),

@@ -119,8 +119,9 @@ std::vector<InflowAttachment> inflow_attachments(const tracker::SurfaceMesh& mes
 }
 
 OpenBoundaryReport apply_open_boundaries(tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
-                                         const fluid::BoundaryOptions& boundaries, double dt,
-                                         int liquid_region, const OpenBoundaryOptions& options,
+                                         const fluid::BoundaryOptions& boundaries, double time,
+                                         double dt, int liquid_region,
+                                         const OpenBoundaryOptions& options,
                                          VolumeTracker* volumes) {
     options.validate();
     if (!(dt > 0.0) || !std::isfinite(dt))
@@ -137,7 +138,9 @@ OpenBoundaryReport apply_open_boundaries(tracker::SurfaceMesh& mesh, const fluid
         const fluid::FaceBoundary& face = boundaries.face(a.axis, a.side);
         if (face.inflow.speed == 0.0)
             continue;
-        const double entered = fluid::inflow_volume_rate(grid, boundaries, a.axis, a.side) * dt;
+        // The step's velocities are those of its end: its inflow rate too.
+        const double entered =
+            fluid::inflow_volume_rate(grid, boundaries, a.axis, a.side, time) * dt;
         const bool liquid = face.inflow.phase == fluid::InflowPhase::liquid;
         count(report.volumes, true, liquid, entered);
         if (!volumes)

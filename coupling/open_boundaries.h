@@ -90,13 +90,15 @@ std::vector<std::uint8_t> held_vertices(const tracker::SurfaceMesh& mesh, const 
                                         const fluid::BoundaryOptions& boundaries);
 
 /// One step's mesh changes and volume bookkeeping at the open faces (see the file comment):
-/// clips the mesh beyond every outflow face and adds each inflow's volume over `dt` (s, > 0).
+/// clips the mesh beyond every outflow face and adds each inflow's volume over the step of `dt`
+/// (s, > 0) that ended at `time` (s; the fluid's, for a pulsed inflow).
 /// `liquid_region` is the label of the liquid (RasterizeOptions::liquid_region). With
 /// `volumes` (between its begin_step() and match_components()) the targets follow. Throws
 /// std::invalid_argument on invalid options or dt.
 OpenBoundaryReport apply_open_boundaries(tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
-                                         const fluid::BoundaryOptions& boundaries, double dt,
-                                         int liquid_region, const OpenBoundaryOptions& options,
+                                         const fluid::BoundaryOptions& boundaries, double time,
+                                         double dt, int liquid_region,
+                                         const OpenBoundaryOptions& options,
                                          VolumeTracker* volumes);
 
 }  // namespace meniscus::coupling

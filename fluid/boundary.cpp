@@ -57,11 +57,11 @@ void for_each_boundary_face(const MacGrid& grid, int axis, int side, Visit&& vis
 
 /// The inflow's normal velocity (m/s, along +axis) averaged over a square of edge `width` (m;
 /// 0 for the value at `point`) centred at `point` on face (axis, side), a region containing it
-/// whole: the parabolas are quadratic, so their mean takes each coordinate's mean square,
-/// t_c² + width²/12.
+/// whole, at `time` (s): the parabolas are quadratic, so their mean takes each coordinate's mean
+/// square, t_c² + width²/12.
 double profile_velocity(const BoundaryOptions& boundaries, int axis, int side,
                         const Eigen::Vector3d& point, const Eigen::Vector3d& box_min,
-                        const Eigen::Vector3d& box_max, double width) {
+                        const Eigen::Vector3d& box_max, double width, double time) {
     const FaceBoundary& f = boundaries.face(axis, side);
     if (f.type != BoundaryType::inflow || f.inflow.speed == 0.0)
         return 0.0;
@@ -87,7 +87,7 @@ double profile_velocity(const BoundaryOptions& boundaries, int axis, int side,
         }
     }
     const double into_box = side == 0 ? 1.0 : -1.0;
-    return into_box * in.speed * shape;
+    return into_box * in.speed_at(time) * shape;
 }
 
 }  // namespace
@@ -177,6 +177,14 @@ void BoundaryOptions::validate() const {
             if (!(std::isfinite(in.speed) && in.speed >= 0.0))
                 throw std::invalid_argument(name +
                                             "/inflow/speed: expected a finite speed >= 0 (m/s)");
+            if (!(in.pulse >= 0.0 && in.pulse < 1.0))
+                throw std::invalid_argument(name + "/inflow/pulse: expected a number in [0, 1)");
+            if (!(std::isfinite(in.pulse_frequency) && in.pulse_frequency >= 0.0))
+                throw std::invalid_argument(name +
+                                            "/inflow/pulse_frequency: expected a finite number >= 0 (Hz)");
+            if (in.pulse > 0.0 && in.pulse_frequency == 0.0)
+                throw std::invalid_argument(name +
+                                            "/inflow/pulse_frequency: a pulsed inflow needs a frequency > 0 (Hz)");
             if (in.profile != InflowProfile::uniform && in.profile != InflowProfile::parabolic)
                 throw std::invalid_argument(name + "/inflow/profile: unknown profile");
             if (in.region != InflowRegion::face && in.region != InflowRegion::disc)
@@ -198,28 +206,33 @@ void BoundaryOptions::validate() const {
             "a closed box; make a face outflow");
 }
 
+double InflowOptions::speed_at(double time) const {
+    return pulse == 0.0 ? speed : speed * (1.0 + pulse * std::sin(2.0 * M_PI * pulse_frequency * time));
+}
+
 double boundary_normal_velocity(const BoundaryOptions& boundaries, int axis, int side,
                                 const Eigen::Vector3d& point, const Eigen::Vector3d& box_min,
-                                const Eigen::Vector3d& box_max) {
-    return profile_velocity(boundaries, axis, side, point, box_min, box_max, 0.0);
+                                const Eigen::Vector3d& box_max, double time) {
+    return profile_velocity(boundaries, axis, side, point, box_min, box_max, 0.0, time);
 }
 
 double face_inflow_velocity(const BoundaryOptions& boundaries, int axis, int side,
                             const Eigen::Vector3d& face_centre, double dx,
-                            const Eigen::Vector3d& box_min, const Eigen::Vector3d& box_max) {
+                            const Eigen::Vector3d& box_min, const Eigen::Vector3d& box_max,
+                            double time) {
     const FaceBoundary& f = boundaries.face(axis, side);
     if (f.type != BoundaryType::inflow || f.inflow.speed == 0.0)
         return 0.0;
     // Where the profile is smooth over the face, its mean over the face in closed form.
     if (f.inflow.region != InflowRegion::disc)
-        return profile_velocity(boundaries, axis, side, face_centre, box_min, box_max, dx);
+        return profile_velocity(boundaries, axis, side, face_centre, box_min, box_max, dx, time);
     double r2 = 0.0;
     for (int b = 0; b < 3; ++b)
         if (b != axis)
             r2 += (face_centre[b] - f.inflow.centre[b]) * (face_centre[b] - f.inflow.centre[b]);
     const double reach = std::sqrt(0.5) * dx;  // half the face's diagonal
     if (std::abs(std::sqrt(r2) - f.inflow.radius) > reach)
-        return profile_velocity(boundaries, axis, side, face_centre, box_min, box_max, dx);
+        return profile_velocity(boundaries, axis, side, face_centre, box_min, box_max, dx, time);
     // The disc's rim crosses the face: the mean of sub-samples.
     const int b = (axis + 1) % 3, c = (axis + 2) % 3;
     const double sub = dx / RIM_SUBSAMPLES;
@@ -229,12 +242,12 @@ double face_inflow_velocity(const BoundaryOptions& boundaries, int axis, int sid
             Eigen::Vector3d x = face_centre;
             x[b] += dx * ((sb + 0.5) / RIM_SUBSAMPLES - 0.5);
             x[c] += dx * ((sc + 0.5) / RIM_SUBSAMPLES - 0.5);
-            sum += profile_velocity(boundaries, axis, side, x, box_min, box_max, sub);
+            sum += profile_velocity(boundaries, axis, side, x, box_min, box_max, sub, time);
         }
     return sum / (RIM_SUBSAMPLES * RIM_SUBSAMPLES);
 }
 
-void apply_boundary_velocity(MacGrid& grid, const BoundaryOptions& boundaries) {
+void apply_boundary_velocity(MacGrid& grid, const BoundaryOptions& boundaries, double time) {
     const Eigen::Vector3d box_min = grid.origin();
     const Eigen::Vector3d box_max =
         grid.origin() + grid.dx() * Eigen::Vector3d(grid.nx(), grid.ny(), grid.nz());
@@ -255,7 +268,7 @@ void apply_boundary_velocity(MacGrid& grid, const BoundaryOptions& boundaries) {
                     type == BoundaryType::inflow
                         ? face_inflow_velocity(boundaries, axis, side,
                                                grid.face_centre(axis, i, j, k), grid.dx(),
-                                               box_min, box_max)
+                                               box_min, box_max, time)
                         : 0.0;
             });
         }
@@ -263,7 +276,7 @@ void apply_boundary_velocity(MacGrid& grid, const BoundaryOptions& boundaries) {
 }
 
 double inflow_volume_rate(const MacGrid& grid, const BoundaryOptions& boundaries, int axis,
-                          int side) {
+                          int side, double time) {
     if (boundaries.at(axis, side) != BoundaryType::inflow)
         return 0.0;
     const double area = grid.dx() * grid.dx();
@@ -275,16 +288,16 @@ double inflow_volume_rate(const MacGrid& grid, const BoundaryOptions& boundaries
     for_each_boundary_face(grid, axis, side, [&](int i, int j, int k) {
         rate += into_box * area *
                 face_inflow_velocity(boundaries, axis, side, grid.face_centre(axis, i, j, k),
-                                     grid.dx(), box_min, box_max);
+                                     grid.dx(), box_min, box_max, time);
     });
     return rate;
 }
 
-double inflow_volume_rate(const MacGrid& grid, const BoundaryOptions& boundaries) {
+double inflow_volume_rate(const MacGrid& grid, const BoundaryOptions& boundaries, double time) {
     double rate = 0.0;
     for (int axis = 0; axis < 3; ++axis)
         for (int side = 0; side < 2; ++side)
-            rate += inflow_volume_rate(grid, boundaries, axis, side);
+            rate += inflow_volume_rate(grid, boundaries, axis, side, time);
     return rate;
 }
 

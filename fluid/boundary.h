@@ -44,12 +44,19 @@ enum class InflowPhase { liquid, gas };
 /// An inflow's region and speed.
 struct InflowOptions {
     double speed = 0.0;  ///< mean normal speed into the box over the region, m/s (≥ 0)
+    /// Relative amplitude ε of a sinusoidal modulation of the speed, speed·(1 + ε sin 2πft), in
+    /// [0, 1) (0: steady): a forced jet, as Rayleigh's and most breakup experiments are run.
+    double pulse = 0.0;
+    double pulse_frequency = 0.0;  ///< f, Hz (> 0 when pulse > 0)
     InflowProfile profile = InflowProfile::uniform;
     InflowRegion region = InflowRegion::face;
     /// disc: centre (m); its coordinate along the face's normal is ignored.
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     double radius = 0.0;  ///< disc: radius (m, > 0)
     InflowPhase phase = InflowPhase::liquid;
+
+    /// The mean speed over the region at `time` (s): speed·(1 + pulse·sin 2π pulse_frequency t).
+    double speed_at(double time) const;
 };
 
 /// The condition on one face of the box.
@@ -99,7 +106,7 @@ struct BoundaryOptions {
 /// prescribed.
 double boundary_normal_velocity(const BoundaryOptions& boundaries, int axis, int side,
                                 const Eigen::Vector3d& point, const Eigen::Vector3d& box_min,
-                                const Eigen::Vector3d& box_max);
+                                const Eigen::Vector3d& box_max, double time = 0.0);
 
 /// The velocity (m/s, along +axis) of the grid face of edge `dx` centred at `face_centre` on face
 /// (axis, side): the mean of boundary_normal_velocity() over the face — in closed form where the
@@ -108,18 +115,21 @@ double boundary_normal_velocity(const BoundaryOptions& boundaries, int axis, int
 /// inside a disc (+13 % at R = 3 cells) or of the parabola's midpoint rule.
 double face_inflow_velocity(const BoundaryOptions& boundaries, int axis, int side,
                             const Eigen::Vector3d& face_centre, double dx,
-                            const Eigen::Vector3d& box_min, const Eigen::Vector3d& box_max);
+                            const Eigen::Vector3d& box_min, const Eigen::Vector3d& box_max,
+                            double time = 0.0);
 
 /// Sets the normal velocity on every boundary face of `grid`: walls 0, inflows their profile
 /// (face_inflow_velocity()), outflows the velocity of the interior face next to them (zero
 /// normal gradient).
-void apply_boundary_velocity(MacGrid& grid, const BoundaryOptions& boundaries);
+/// `time` (s) is that of the velocities (a pulsed inflow's phase).
+void apply_boundary_velocity(MacGrid& grid, const BoundaryOptions& boundaries, double time = 0.0);
 
 /// Volume flux (m³/s) into the box through the inflow faces of `grid` as apply_boundary_velocity()
 /// sets them (the sum of face velocity × face area over the inflow faces).
-double inflow_volume_rate(const MacGrid& grid, const BoundaryOptions& boundaries);
+double inflow_volume_rate(const MacGrid& grid, const BoundaryOptions& boundaries,
+                          double time = 0.0);
 /// The same through face (axis, side) alone (0 unless it is an inflow).
 double inflow_volume_rate(const MacGrid& grid, const BoundaryOptions& boundaries, int axis,
-                          int side);
+                          int side, double time = 0.0);
 
 }  // namespace meniscus::fluid

@@ -84,7 +84,8 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
     PhaseClock step_clock;
     PhaseClock clock;
     advect_velocity(m_grid, dt, m_options.advection, &m_options.boundaries);
-    apply_boundary_velocity(m_grid, m_options.boundaries);
+    m_time += dt;  // the step's velocities are those of its end
+    apply_boundary_velocity(m_grid, m_options.boundaries, m_time);
     clock.lap_into(result.timings.advection);
 
     if (m_options.viscous_pressure.coupling == ViscousPressureCoupling::split) {
@@ -312,6 +313,7 @@ void FluidSolver::save_state(BinaryWriter& out) const {
     if (m_increment.size() > 0)
         save_array(out, m_increment);
     out.put_vector(m_was_liquid);
+    out.put(m_time);
 }
 
 void FluidSolver::load_state(BinaryReader& in) {
@@ -332,11 +334,15 @@ void FluidSolver::load_state(BinaryReader& in) {
     std::vector<char> was_liquid = in.get_vector<char>();
     if (!was_liquid.empty() && was_liquid.size() != m_pressure.size())
         throw FormatError("fluid state: the liquid flags do not match the grid");
+    const double time = in.get<double>();
+    if (!std::isfinite(time) || time < 0.0)
+        throw FormatError("fluid state: the time is not a number >= 0");
     for (int axis = 0; axis < 3; ++axis)
         m_grid.velocity(axis) = std::move(velocity[static_cast<size_t>(axis)]);
     m_pressure = std::move(pressure);
     m_increment = std::move(increment);
     m_was_liquid = std::move(was_liquid);
+    m_time = time;
 }
 
 }  // namespace meniscus::fluid

@@ -110,6 +110,8 @@ public:
     /// (free_surface); mean zero when the system is pure Neumann (two_phase). The incremental
     /// and coupled schemes start the next step from it.
     const Array3<double>& pressure() const { return m_pressure; }
+    /// Time (s) of the velocities: the sum of the steps taken (a pulsed inflow's phase).
+    double time() const { return m_time; }
     const FluidOptions& options() const { return m_options; }
 
     /// Exact state for checkpoints: the face velocities, the pressure the next step starts
@@ -130,6 +132,7 @@ private:
     Array3<double> m_increment;  ///< scratch: the projection's pressure increment δ
     ViscositySolver m_viscosity;
     std::vector<char> m_was_liquid;  ///< liquid flags of the last step's cells (empty at first)
+    double m_time = 0.0;
 };
 
 }  // namespace meniscus::fluid

@@ -104,11 +104,13 @@ TEST(OpenBoundaries, PoiseuilleFlowBetweenInflowAndOutflow) {
 TEST(OpenBoundaries, LiquidUnderAnOpenTopStaysAtRest) {
     // All liquid, gravity down, the top an outflow at p0: rest is exact (gravity reaches the open
     // faces, which the pressure gradient balances), p = p0 + ρ g (H − z), and nothing flows out.
-    for (ViscousPressureCoupling coupling :
-         {ViscousPressureCoupling::split, ViscousPressureCoupling::coupled}) {
+    // Both viscous-pressure schemes, and the free-surface mode (gas as void) too.
+    for (int variant = 0; variant < 3; ++variant) {
         FluidOptions options;
         options.phases = {RHO, 1.0, 1e-3, 1e-5, 0.0};
-        options.viscous_pressure.coupling = coupling;
+        options.viscous_pressure.coupling =
+            variant == 0 ? ViscousPressureCoupling::split : ViscousPressureCoupling::coupled;
+        options.mode = variant == 2 ? FluidMode::free_surface : FluidMode::two_phase;
         options.pressure.iteration.tolerance = 1e-12;
         options.boundaries.z_max.type = BoundaryType::outflow;
         const double p0 = 250.0;
@@ -225,6 +227,37 @@ TEST(OpenBoundaries, InflowBringsNoTangentialVelocity) {
     }
 }
 
+TEST(OpenBoundaries, APulsedInflowFollowsItsSineAtTheStepsEnd) {
+    // speed·(1 + ε sin 2πft) on the inflow's faces at the time the step ends.
+    FluidOptions options;
+    options.gravity = Eigen::Vector3d::Zero();
+    options.phases = {1000.0, 1000.0, 1e-3, 1e-3, 0.0};
+    options.boundaries.x_min.type = BoundaryType::inflow;
+    options.boundaries.x_min.inflow.speed = 0.5;
+    options.boundaries.x_min.inflow.pulse = 0.2;
+    options.boundaries.x_min.inflow.pulse_frequency = 50.0;
+    options.boundaries.x_max.type = BoundaryType::outflow;
+    FluidSolver solver(8, 4, 4, 0.01, Eigen::Vector3d::Zero(), options);
+    EXPECT_DOUBLE_EQ(solver.grid().u()(0, 2, 2), 0.5);  // t = 0: sin 0
+    const InterfaceInput interface(solver.grid());
+    double t = 0.0;
+    for (const double dt : {1e-3, 2e-3, 1.5e-3}) {
+        solver.step(dt, interface);
+        t += dt;
+        EXPECT_DOUBLE_EQ(solver.time(), t);
+        const double expected = 0.5 * (1.0 + 0.2 * std::sin(2.0 * M_PI * 50.0 * t));
+        EXPECT_NEAR(solver.grid().u()(0, 2, 2), expected, 1e-15);
+        EXPECT_NEAR(inflow_volume_rate(solver.grid(), options.boundaries, t),
+                    expected * 0.04 * 0.04, 1e-15);
+        // Incompressible: what comes in leaves through the outflow at once.
+        double out = 0.0;
+        for (int k = 0; k < 4; ++k)
+            for (int j = 0; j < 4; ++j)
+                out += solver.grid().u()(8, j, k) * 0.01 * 0.01;
+        EXPECT_NEAR(out, expected * 0.04 * 0.04, 1e-9 * expected * 0.04 * 0.04);
+    }
+}
+
 TEST(OpenBoundaries, OptionsNameTheFaceAndTheConflict) {
     BoundaryOptions b;
     b.x_min.type = BoundaryType::inflow;
@@ -245,6 +278,11 @@ TEST(OpenBoundaries, OptionsNameTheFaceAndTheConflict) {
     b.z_max.pressure = NAN;
     expect_error([&] { b.validate(); }, "z_max/pressure");
     b.z_max.pressure = 0.0;
+    b.x_min.inflow.pulse = 0.1;
+    expect_error([&] { b.validate(); }, "x_min/inflow/pulse_frequency: a pulsed inflow needs");
+    b.x_min.inflow.pulse = 1.0;
+    expect_error([&] { b.validate(); }, "x_min/inflow/pulse: expected a number in [0, 1)");
+    b.x_min.inflow.pulse = 0.0;
     FluidOptions options;
     options.boundaries = b;
     options.boundaries.y_max.type = static_cast<BoundaryType>(17);
