@@ -53,7 +53,8 @@ void OpenBoundaryOptions::validate() const {
         throw std::invalid_argument("clip_far_cells: expected a number > clip_near_cells");
 }
 
-std::vector<std::uint8_t> held_vertices(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
+std::vector<std::uint8_t> held_vertices(const tracker::SurfaceMesh& mesh,
+                                        const fluid::MacGrid& grid,
                                         const fluid::BoundaryOptions& boundaries) {
     std::vector<std::uint8_t> held(static_cast<size_t>(mesh.num_vertices()), 0);
     const Box box(grid);
@@ -111,7 +112,8 @@ std::vector<InflowAttachment> inflow_attachments(const tracker::SurfaceMesh& mes
                     if (mesh.triangle_alive(tj) &&
                         components.triangle_component[static_cast<size_t>(tj)] == comp)
                         for (int v : mesh.triangle(tj))
-                            a.reach = std::max(a.reach, inward * (mesh.position(v)[axis] - centre[axis]));
+                            a.reach =
+                                std::max(a.reach, inward * (mesh.position(v)[axis] - centre[axis]));
             }
             attached.push_back(a);
         }
@@ -131,9 +133,9 @@ OpenBoundaryReport apply_open_boundaries(tracker::SurfaceMesh& mesh, const fluid
     const double dx = grid.dx();
 
     // Inflow: the volume of the step goes to the component behind the face.
-    const std::vector<InflowAttachment> attached =
-        boundaries.inflow() ? inflow_attachments(mesh, grid, boundaries)
-                            : std::vector<InflowAttachment>{};
+    const std::vector<InflowAttachment> attached = boundaries.inflow()
+                                                       ? inflow_attachments(mesh, grid, boundaries)
+                                                       : std::vector<InflowAttachment>{};
     for (const InflowAttachment& a : attached) {
         const fluid::FaceBoundary& face = boundaries.face(a.axis, a.side);
         if (face.inflow.speed == 0.0)

@@ -86,7 +86,8 @@ std::vector<InflowAttachment> inflow_attachments(const tracker::SurfaceMesh& mes
 
 /// 1 for every live vertex beyond an inflow face of the box (the nozzle's part of the mesh,
 /// which the fluid does not move), 0 elsewhere; sized mesh.num_vertices().
-std::vector<std::uint8_t> held_vertices(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
+std::vector<std::uint8_t> held_vertices(const tracker::SurfaceMesh& mesh,
+                                        const fluid::MacGrid& grid,
                                         const fluid::BoundaryOptions& boundaries);
 
 /// One step's mesh changes and volume bookkeeping at the open faces (see the file comment):

@@ -128,9 +128,9 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     if (boundaries.inflow())
         held = held_vertices(mesh, grid, boundaries);
     report.improve = m_tracker->improve(held.empty() ? nullptr : &held);
-    report.open_boundaries = apply_open_boundaries(mesh, grid, boundaries, m_fluid.time(), report.dt,
-                                                   m_options.rasterize.liquid_region,
-                                                   m_options.open_boundaries, m_volumes.get());
+    report.open_boundaries = apply_open_boundaries(
+        mesh, grid, boundaries, m_fluid.time(), report.dt, m_options.rasterize.liquid_region,
+        m_options.open_boundaries, m_volumes.get());
     m_boundary_volumes += report.open_boundaries.volumes;
     report.topology = m_tracker->change_topology();  // compacts
     clock.lap_into(timings.tracker);

@@ -6,8 +6,9 @@
 /// (trilinear interpolation of each staggered component on its own lattice). Points that leave the
 /// box are sampled with constant extrapolation of the nearest samples, except for the velocity
 /// components tangential to an inflow face (boundary.h): the inflow brings no tangential
-/// velocity, so they fall linearly to 0 from the first sample to the face and are 0 beyond it. Every scheme reproduces
-/// constant fields exactly and linear fields exactly wherever the departure points stay in the box.
+/// velocity, so they fall linearly to 0 from the first sample to the face and are 0 beyond it.
+/// Every scheme reproduces constant fields exactly and linear fields exactly wherever the departure
+/// points stay in the box.
 
 #include "fluid/array3.h"
 #include "fluid/boundary.h"

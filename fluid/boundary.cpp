@@ -8,8 +8,8 @@ namespace meniscus::fluid {
 
 namespace {
 
-constexpr const char* FACE_NAMES[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"},
-                                          {"z_min", "z_max"}};
+constexpr const char* FACE_NAMES[3][2] = {
+    {"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
 /// Mean of 1 − s² over s ∈ [−1, 1] is 2/3: a parabola of mean 1 peaks at 3/2.
 constexpr double PLANE_PARABOLA_PEAK = 1.5;
 /// Mean of 1 − r²/R² over a disc is 1/2: a paraboloid of mean 1 peaks at 2.
@@ -76,7 +76,8 @@ double profile_velocity(const BoundaryOptions& boundaries, int axis, int side,
         if (r2 >= in.radius * in.radius)
             return 0.0;
         if (in.profile == InflowProfile::parabolic)
-            shape = DISC_PARABOLA_PEAK * std::max(0.0, 1.0 - (r2 + 2.0 * spread) / (in.radius * in.radius));
+            shape = DISC_PARABOLA_PEAK *
+                    std::max(0.0, 1.0 - (r2 + 2.0 * spread) / (in.radius * in.radius));
     } else if (in.profile == InflowProfile::parabolic) {
         for (int b = 0; b < 3; ++b) {
             if (b == axis || !walled_axis(boundaries, b))
@@ -110,18 +111,10 @@ bool BoundaryOptions::moving() const {
     return false;
 }
 
-bool BoundaryOptions::open() const {
+bool BoundaryOptions::has(BoundaryType type) const {
     for (int axis = 0; axis < 3; ++axis)
         for (int side = 0; side < 2; ++side)
-            if (at(axis, side) == BoundaryType::outflow)
-                return true;
-    return false;
-}
-
-bool BoundaryOptions::inflow() const {
-    for (int axis = 0; axis < 3; ++axis)
-        for (int side = 0; side < 2; ++side)
-            if (at(axis, side) == BoundaryType::inflow)
+            if (at(axis, side) == type)
                 return true;
     return false;
 }
@@ -147,7 +140,7 @@ BoundaryOptions BoundaryOptions::all(BoundaryType type) {
 }
 
 void BoundaryOptions::validate() const {
-    bool liquid_in = false;
+    std::string inflow_face;  // the first inflow with a speed
     for (int axis = 0; axis < 3; ++axis)
         for (int side = 0; side < 2; ++side) {
             const FaceBoundary& f = face(axis, side);
@@ -155,8 +148,9 @@ void BoundaryOptions::validate() const {
             if (f.type != BoundaryType::free_slip && f.type != BoundaryType::no_slip &&
                 f.type != BoundaryType::inflow && f.type != BoundaryType::outflow)
                 throw std::invalid_argument(
-                    name + "/type: unknown boundary type (use free_slip, no_slip, inflow or "
-                           "outflow)");
+                    name +
+                    "/type: unknown boundary type (use free_slip, no_slip, inflow or "
+                    "outflow)");
             if (!f.velocity.allFinite())
                 throw std::invalid_argument(name + "/velocity: expected finite numbers (m/s)");
             if (f.velocity[axis] != 0.0)
@@ -180,11 +174,11 @@ void BoundaryOptions::validate() const {
             if (!(in.pulse >= 0.0 && in.pulse < 1.0))
                 throw std::invalid_argument(name + "/inflow/pulse: expected a number in [0, 1)");
             if (!(std::isfinite(in.pulse_frequency) && in.pulse_frequency >= 0.0))
-                throw std::invalid_argument(name +
-                                            "/inflow/pulse_frequency: expected a finite number >= 0 (Hz)");
+                throw std::invalid_argument(
+                    name + "/inflow/pulse_frequency: expected a finite number >= 0 (Hz)");
             if (in.pulse > 0.0 && in.pulse_frequency == 0.0)
-                throw std::invalid_argument(name +
-                                            "/inflow/pulse_frequency: a pulsed inflow needs a frequency > 0 (Hz)");
+                throw std::invalid_argument(
+                    name + "/inflow/pulse_frequency: a pulsed inflow needs a frequency > 0 (Hz)");
             if (in.profile != InflowProfile::uniform && in.profile != InflowProfile::parabolic)
                 throw std::invalid_argument(name + "/inflow/profile: unknown profile");
             if (in.region != InflowRegion::face && in.region != InflowRegion::disc)
@@ -197,17 +191,19 @@ void BoundaryOptions::validate() const {
                 !(std::isfinite(in.radius) && in.radius > 0.0))
                 throw std::invalid_argument(name +
                                             "/inflow/radius: a disc inflow needs a radius > 0 (m)");
-            if (f.type == BoundaryType::inflow && in.speed > 0.0)
-                liquid_in = true;
+            if (f.type == BoundaryType::inflow && in.speed > 0.0 && inflow_face.empty())
+                inflow_face = name;
         }
-    if (liquid_in && !open())
+    if (!inflow_face.empty() && !open())
         throw std::invalid_argument(
-            "inflow without an outflow face: the fluid flowing in would have nowhere to go in "
-            "a closed box; make a face outflow");
+            inflow_face +
+            "/inflow/speed: an inflow without an outflow face: the fluid flowing in would have "
+            "nowhere to go in a closed box; make another face outflow");
 }
 
 double InflowOptions::speed_at(double time) const {
-    return pulse == 0.0 ? speed : speed * (1.0 + pulse * std::sin(2.0 * M_PI * pulse_frequency * time));
+    return pulse == 0.0 ? speed
+                        : speed * (1.0 + pulse * std::sin(2.0 * M_PI * pulse_frequency * time));
 }
 
 double boundary_normal_velocity(const BoundaryOptions& boundaries, int axis, int side,
@@ -260,16 +256,15 @@ void apply_boundary_velocity(MacGrid& grid, const BoundaryOptions& boundaries, d
                 if (type == BoundaryType::outflow) {
                     int next[3] = {i, j, k};
                     next[axis] += inward;
-                    faces(i, j, k) = grid.cells(axis) > 1 ? faces(next[0], next[1], next[2])
-                                                          : faces(i, j, k);
+                    faces(i, j, k) =
+                        grid.cells(axis) > 1 ? faces(next[0], next[1], next[2]) : faces(i, j, k);
                     return;
                 }
-                faces(i, j, k) =
-                    type == BoundaryType::inflow
-                        ? face_inflow_velocity(boundaries, axis, side,
-                                               grid.face_centre(axis, i, j, k), grid.dx(),
-                                               box_min, box_max, time)
-                        : 0.0;
+                faces(i, j, k) = type == BoundaryType::inflow
+                                     ? face_inflow_velocity(boundaries, axis, side,
+                                                            grid.face_centre(axis, i, j, k),
+                                                            grid.dx(), box_min, box_max, time)
+                                     : 0.0;
             });
         }
     }

@@ -24,7 +24,7 @@ enum class BoundaryType { free_slip, no_slip, inflow, outflow };
 
 /// Profile of an inflow's normal speed over its region.
 enum class InflowProfile {
-    uniform,   ///< the same speed everywhere in the region
+    uniform,  ///< the same speed everywhere in the region
     /// zero on the region's rim where it meets a wall or inflow and maximal in its middle (the
     /// developed laminar profile): over a disc 2U(1 − r²/R²); over the whole face the product of
     /// 3/2 (1 − s²) across each in-plane axis bounded by walls on both sides (s ∈ [−1, 1] across
@@ -84,10 +84,12 @@ struct BoundaryOptions {
     BoundaryType at(int axis, int side) const { return face(axis, side).type; }
     /// True if any wall slides along itself.
     bool moving() const;
+    /// True if any face is of `type`.
+    bool has(BoundaryType type) const;
     /// True if any face is an outflow (the pressure is then fixed somewhere: no null space).
-    bool open() const;
+    bool open() const { return has(BoundaryType::outflow); }
     /// True if any face is an inflow.
-    bool inflow() const;
+    bool inflow() const { return has(BoundaryType::inflow); }
     /// The same faces with homogeneous data: walls at rest, inflows at zero speed, outflows at
     /// zero pressure (for the solves of velocity and pressure increments).
     BoundaryOptions at_rest() const;

@@ -84,7 +84,9 @@ bool join_hole(const std::vector<Vec2>& pts, std::vector<int>& ring, const std::
     const Vec2& m_next = pts[static_cast<size_t>(next_in(hole, mi))];
     std::vector<size_t> order(ring.size());
     std::iota(order.begin(), order.end(), size_t{0});
-    const auto distance2 = [&](size_t i) { return (pts[static_cast<size_t>(ring[i])] - m).squaredNorm(); };
+    const auto distance2 = [&](size_t i) {
+        return (pts[static_cast<size_t>(ring[i])] - m).squaredNorm();
+    };
     std::stable_sort(order.begin(), order.end(),
                      [&](size_t a, size_t b) { return distance2(a) < distance2(b); });
     const auto clears_loop = [&](const std::vector<int>& loop, const Vec2& p) {
@@ -227,7 +229,8 @@ PolygonTriangulation triangulate_polygon(const std::vector<Eigen::Vector2d>& poi
     const auto check = [&](const std::vector<int>& loop) {
         for (int i : loop)
             if (i < 0 || static_cast<size_t>(i) >= points.size())
-                throw std::invalid_argument("triangulate_polygon: a loop index is outside the points");
+                throw std::invalid_argument(
+                    "triangulate_polygon: a loop index is outside the points");
     };
     check(polygon.outer);
     for (const std::vector<int>& hole : polygon.holes)
@@ -252,9 +255,8 @@ PolygonTriangulation triangulate_polygon(const std::vector<Eigen::Vector2d>& poi
             x = std::max(x, points[static_cast<size_t>(i)].x());
         return x;
     };
-    std::stable_sort(holes.begin(), holes.end(), [&](const auto* a, const auto* b) {
-        return rightmost(a) > rightmost(b);
-    });
+    std::stable_sort(holes.begin(), holes.end(),
+                     [&](const auto* a, const auto* b) { return rightmost(a) > rightmost(b); });
     std::vector<int> ring = polygon.outer;
     for (size_t h = 0; h < holes.size(); ++h) {
         const std::vector<const std::vector<int>*> others(holes.begin() + static_cast<long>(h) + 1,

@@ -103,7 +103,8 @@ IntegrateResult SurfaceTracker::integrate(const std::vector<Vec3>& velocities, d
     if (!(dt > 0.0) || !std::isfinite(dt))
         throw std::invalid_argument("SurfaceTracker::integrate: dt must be a finite number > 0");
     if (pinned && pinned->size() != velocities.size())
-        throw std::invalid_argument("SurfaceTracker::integrate: pinned must be sized num_vertices()");
+        throw std::invalid_argument(
+            "SurfaceTracker::integrate: pinned must be sized num_vertices()");
     const std::vector<Vec3>& x0 = m_mesh.positions();
     std::vector<Vec3> x1(x0.size());
     for (size_t i = 0; i < x0.size(); ++i) {

@@ -226,7 +226,7 @@ TEST(Scene, BoundariesAreATypeOrAnObjectAndErrorsNameTheFace) {
                   .find("/fluid/boundaries/x_min/speeed: unknown key"),
               std::string::npos);
     EXPECT_NE(error_of(sphere + R"({"boundaries": {"x_min": {"type": "inflow", "inflow": {"speed": 1}}}}})")
-                  .find("inflow without an outflow face"),
+                  .find("/fluid/boundaries/x_min/inflow/speed: an inflow without an outflow face"),
               std::string::npos);
     EXPECT_NE(error_of(sphere + R"({"boundaries": {"z_max": {"type": "outflow", "velocity": [1, 0, 0]}}}})")
                   .find("/fluid/boundaries/z_max/velocity: only a no_slip wall"),

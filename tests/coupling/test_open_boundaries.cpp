@@ -71,9 +71,10 @@ TEST(OpenBoundaries, DropCarriedOutThroughAnOutflowFaceIsRemovedCleanly) {
             }
         }
     }
-    std::printf("[ measured ] drop through an outflow face: %d steps, %d clips, liquid out %.4e "
-                "of %.4e m^3, worst |left + out - start| / start %.2e\n",
-                steps, clips, sim.boundary_volumes().liquid_out, v0, worst_balance);
+    std::printf(
+        "[ measured ] drop through an outflow face: %d steps, %d clips, liquid out %.4e "
+        "of %.4e m^3, worst |left + out - start| / start %.2e\n",
+        steps, clips, sim.boundary_volumes().liquid_out, v0, worst_balance);
     EXPECT_EQ(sim.tracker().mesh().count_live_triangles(), 0);  // gone, in a finite time
     EXPECT_EQ(removed, 1);
     EXPECT_GT(clips, 3);  // cut slice by slice, not dropped whole
@@ -137,9 +138,10 @@ TEST(OpenBoundaries, JetGrowsFromTheNozzleRimByTheVolumeThatFlowsIn) {
     const double grown = tracker::enclosed_volume(mesh) - v0;
     const double entered = sim.boundary_volumes().liquid_in;
     const double expected = speed * M_PI * radius * radius * duration;
-    std::printf("[ measured ] jet from a nozzle after %.0f ms: volume grew %.4e m^3, %.4e flowed "
-                "in (%.4e = speed x area x time); tip %.3f -> %.3f mm\n",
-                duration * 1e3, grown, entered, expected, tip0 * 1e3, tip() * 1e3);
+    std::printf(
+        "[ measured ] jet from a nozzle after %.0f ms: volume grew %.4e m^3, %.4e flowed "
+        "in (%.4e = speed x area x time); tip %.3f -> %.3f mm\n",
+        duration * 1e3, grown, entered, expected, tip0 * 1e3, tip() * 1e3);
     EXPECT_EQ(unfed, 0);
     EXPECT_NEAR(entered, expected, 5e-3 * expected);  // the rim faces carry their share
     EXPECT_NEAR(grown, entered, 0.01 * entered);

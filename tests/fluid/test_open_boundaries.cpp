@@ -22,8 +22,8 @@ namespace {
 constexpr double HEIGHT = testing::CHANNEL_HEIGHT;  ///< H, m
 constexpr double RHO = testing::CHANNEL_RHO;
 constexpr double MU = testing::CHANNEL_MU;  ///< ν = 1 m²/s
-constexpr double SPEED = 0.01;  ///< U, the mean speed, m/s: Re = U H / ν = 0.01
-constexpr int LENGTH = 4;       ///< channel length in H
+constexpr double SPEED = 0.01;              ///< U, the mean speed, m/s: Re = U H / ν = 0.01
+constexpr int LENGTH = 4;                   ///< channel length in H
 
 /// Expects `call` to throw std::invalid_argument whose message contains `part`.
 template <class Call>
@@ -90,14 +90,14 @@ TEST(OpenBoundaries, PoiseuilleFlowBetweenInflowAndOutflow) {
         "[ measured ] Poiseuille inflow -> outflow, max |u - exact| / U: N=8 %.3e, N=16 %.3e; "
         "dp/dx / exact: %.5f, %.5f; p next to the outflow / exact: %.5f, %.5f; "
         "|out - in| / in: %.1e, %.1e\n",
-        e8.velocity, e16.velocity, e8.pressure_gradient, e16.pressure_gradient,
-        e8.outlet_pressure, e16.outlet_pressure, e8.flux_balance, e16.flux_balance);
+        e8.velocity, e16.velocity, e8.pressure_gradient, e16.pressure_gradient, e8.outlet_pressure,
+        e16.outlet_pressure, e8.flux_balance, e16.flux_balance);
     // Issue 39: the profile and the pressure drop within 1 % at 16 cells across.
     EXPECT_LT(e16.velocity, 0.01);
     EXPECT_NEAR(e16.pressure_gradient, 1.0, 0.01);
     // The face pressure sits on the face: the last cell is half a cell upstream of it.
     EXPECT_NEAR(e16.outlet_pressure, 1.0, 0.01);
-    EXPECT_LT(e16.flux_balance, 1e-9);  // what enters leaves
+    EXPECT_LT(e16.flux_balance, 1e-9);                      // what enters leaves
     EXPECT_GT(std::log2(e8.velocity / e16.velocity), 1.5);  // about second order in Δx (1.64)
 }
 
@@ -180,7 +180,7 @@ TEST(OpenBoundaries, InflowProfilesCarryTheirMeanSpeed) {
     b.x_min.type = BoundaryType::inflow;
     b.x_max.type = BoundaryType::outflow;
     b.x_min.inflow.speed = 2.0;
-    b.x_min.inflow.profile = InflowProfile::parabolic;  // walled in y and z: 9/4 U at the centre
+    b.x_min.inflow.profile = InflowProfile::parabolic;     // walled in y and z: 9/4 U at the centre
     EXPECT_NEAR(inflow_volume_rate(grid, b), 2.0, 1e-12);  // exact: the face means of the parabolas
     b.z_min.type = b.z_max.type = BoundaryType::free_slip;  // now parabolic across y alone
     apply_boundary_velocity(grid, b);

@@ -71,7 +71,8 @@ TEST(PolygonTriangulation, NonConvexPolygonsWithHolesAreCoveredExactly) {
             area += triangle_area(p, tri);
             // Every triangle inside the polygon: its centroid inside the outer loop, outside holes.
             const Vec2 centroid = (p[static_cast<size_t>(tri[0])] + p[static_cast<size_t>(tri[1])] +
-                                   p[static_cast<size_t>(tri[2])]) / 3.0;
+                                   p[static_cast<size_t>(tri[2])]) /
+                                  3.0;
             EXPECT_TRUE(point_in_loop(p, polygon.outer, centroid));
             for (const std::vector<int>& hole : polygon.holes)
                 EXPECT_FALSE(point_in_loop(p, hole, centroid));
@@ -85,8 +86,9 @@ TEST(PolygonTriangulation, NonConvexPolygonsWithHolesAreCoveredExactly) {
 
 TEST(PolygonTriangulation, RefusesLoopsOfTheWrongOrientation) {
     const std::vector<Vec2> p = {{0, 0}, {4, 0}, {4, 4}, {0, 4}, {1, 1}, {3, 1}, {3, 3}, {1, 3}};
-    EXPECT_FALSE(triangulate_polygon(p, {{3, 2, 1, 0}, {}}).ok);       // clockwise outer loop
-    EXPECT_FALSE(triangulate_polygon(p, {{0, 1, 2, 3}, {{4, 5, 6, 7}}}).ok);  // counter-clockwise hole
+    EXPECT_FALSE(triangulate_polygon(p, {{3, 2, 1, 0}, {}}).ok);  // clockwise outer loop
+    EXPECT_FALSE(
+        triangulate_polygon(p, {{0, 1, 2, 3}, {{4, 5, 6, 7}}}).ok);  // counter-clockwise hole
 }
 
 SurfaceMesh mesh_of(const ShapePtr& shape, double edge) {
@@ -152,7 +154,8 @@ TEST(ClipMesh, NothingBeyondTheRangeChangesNothing) {
 }
 
 TEST(ClipMesh, AComponentWhollyBeyondIsRemovedWithItsVolume) {
-    SurfaceMesh mesh = mesh_of(make_union({make_sphere({0, 0, 0}, 0.5), make_sphere({2, 0, 0}, 0.3)}), 0.08);
+    SurfaceMesh mesh =
+        mesh_of(make_union({make_sphere({0, 0, 0}, 0.5), make_sphere({2, 0, 0}, 0.3)}), 0.08);
     const std::vector<double> volumes = component_volumes(mesh, triangle_components(mesh));
     ClipPlane plane;
     plane.axis = 0;

@@ -135,22 +135,24 @@ ClipReport clip_mesh(SurfaceMesh& mesh, const ClipPlane& plane) {
     Vec3 origin = Vec3::Zero();
     for (const Crossing& x : crossings)
         origin += x.point;
-    origin = crossings.empty() ? Vec3::Zero() : Vec3(origin / static_cast<double>(crossings.size()));
+    origin =
+        crossings.empty() ? Vec3::Zero() : Vec3(origin / static_cast<double>(crossings.size()));
     origin[a] = report.position;
     std::vector<double> removed(static_cast<size_t>(components.count), 0.0);
     std::vector<int> kept_vertex(static_cast<size_t>(components.count), INVALID_INDEX);
     std::vector<char> touched(static_cast<size_t>(components.count), 0);
     std::vector<LabelPair> component_labels(static_cast<size_t>(components.count));
     const auto crossing = [&](int u, int v) {
-        const auto it = crossing_of.find(s[static_cast<size_t>(u)] > 0.0 ? std::pair{v, u}
-                                                                         : std::pair{u, v});
+        const auto it =
+            crossing_of.find(s[static_cast<size_t>(u)] > 0.0 ? std::pair{v, u} : std::pair{u, v});
         return it->second;
     };
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
         if (!mesh.triangle_alive(ti))
             continue;
         const Triangle& tri = mesh.triangle(ti);
-        const size_t comp = static_cast<size_t>(components.triangle_component[static_cast<size_t>(ti)]);
+        const size_t comp =
+            static_cast<size_t>(components.triangle_component[static_cast<size_t>(ti)]);
         component_labels[comp] = mesh.labels(ti);
         int beyond = 0;
         for (int v : tri)
@@ -224,7 +226,8 @@ ClipReport clip_mesh(SurfaceMesh& mesh, const ClipPlane& plane) {
     for (size_t i = 0; i < loops.size(); ++i)
         for (size_t j = 0; j < loops.size(); ++j)
             if (depth[j] == depth[i] - 1 &&
-                point_in_loop(plane_points, loops[j], plane_points[static_cast<size_t>(loops[i][0])]))
+                point_in_loop(plane_points, loops[j],
+                              plane_points[static_cast<size_t>(loops[i][0])]))
                 parent[i] = static_cast<int>(j);
     struct Cap {
         std::vector<std::array<int, 3>> triangles;  // crossings
@@ -289,10 +292,10 @@ ClipReport clip_mesh(SurfaceMesh& mesh, const ClipPlane& plane) {
         }
     for (const Cap& cap : caps)
         for (const std::array<int, 3>& t : cap.triangles) {
-            mesh.add_triangle({plane_vertex[static_cast<size_t>(t[0])],
-                               plane_vertex[static_cast<size_t>(t[1])],
-                               plane_vertex[static_cast<size_t>(t[2])]},
-                              cap.labels);
+            mesh.add_triangle(
+                {plane_vertex[static_cast<size_t>(t[0])], plane_vertex[static_cast<size_t>(t[1])],
+                 plane_vertex[static_cast<size_t>(t[2])]},
+                cap.labels);
             ++report.cap_triangles;
         }
     report.clipped = true;

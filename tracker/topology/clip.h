@@ -60,10 +60,10 @@ struct ClipReport {
     /// was done or there was nothing to do).
     std::string deferred;
     double position = std::numeric_limits<double>::quiet_NaN();  ///< the cut, along the axis
-    int edges_split = 0;        ///< edges crossing the plane, split on it
-    int triangles_removed = 0;  ///< triangles beyond the plane (after the splits), deleted
-    int vertices_removed = 0;   ///< vertices beyond the plane, deleted
-    int cap_triangles = 0;      ///< triangles added to close the cut
+    int edges_split = 0;         ///< edges crossing the plane, split on it
+    int triangles_removed = 0;   ///< triangles beyond the plane (after the splits), deleted
+    int vertices_removed = 0;    ///< vertices beyond the plane, deleted
+    int cap_triangles = 0;       ///< triangles added to close the cut
     int components_removed = 0;  ///< components that went whole
     std::vector<ClippedComponent> components;  ///< one per component cut or removed
 };
