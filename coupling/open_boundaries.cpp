@@ -165,6 +165,7 @@ OpenBoundaryReport apply_open_boundaries(tracker::SurfaceMesh& mesh, const fluid
             plane.side = side;
             plane.near = face + outward * options.clip_near_cells * dx;
             plane.far = face + outward * options.clip_far_cells * dx;
+            plane.gone = face;  // wholly outside the box: gone, wherever the cut falls
             const tracker::ClipReport clip = tracker::clip_mesh(mesh, plane);
             if (!clip.deferred.empty()) {
                 ++report.deferred_clips;

@@ -13,8 +13,9 @@
 /// Outflow: the mesh beyond an outflow face is clipped (tracker/topology/clip.h) between
 /// OpenBoundaryOptions::clip_near_cells and clip_far_cells cells beyond the face, so the surface
 /// still runs on a little past the face: the cells next to it see a smooth surface, not the
-/// cap's crease, in φ and in the curvature. What is removed is reported by phase and taken off
-/// the target of its component (a component that leaves whole takes its target with it).
+/// cap's crease, in φ and in the curvature; a component wholly beyond the face goes whole. What
+/// is removed is reported by phase and taken off the target of its component (a component that
+/// leaves whole takes its target with it).
 
 #include "coupling/volume_correction.h"
 #include "fluid/boundary.h"

@@ -173,6 +173,35 @@ TEST(ClipMesh, AComponentWhollyBeyondIsRemovedWithItsVolume) {
     EXPECT_EQ(triangle_components(mesh).count, 1);
 }
 
+TEST(ClipMesh, ComponentsWhollyBeyondGoneGoWholeWhereverTheCutFalls) {
+    // Three drops: one wholly past `gone` but short of the cut's range (goes whole), one across
+    // `gone` and short of the range (stays as it is), one far inside (stays).
+    SurfaceMesh mesh = mesh_of(make_union({make_sphere({1.3, 0, 0}, 0.2), make_sphere({1.0, 1, 0}, 0.2),
+                                           make_sphere({0, 0, 0}, 0.3)}),
+                               0.05);
+    const std::vector<double> volumes = component_volumes(mesh, triangle_components(mesh));
+    const int triangles = mesh.count_live_triangles();
+    ClipPlane plane;
+    plane.axis = 0;
+    plane.side = 1;
+    plane.gone = 1.05;
+    plane.near = 1.6;
+    plane.far = 1.8;
+    const ClipReport r = clip_mesh(mesh, plane);
+    ASSERT_TRUE(r.clipped) << r.deferred;
+    EXPECT_EQ(r.components_removed, 1);
+    EXPECT_EQ(r.edges_split, 0);
+    EXPECT_EQ(r.cap_triangles, 0);
+    ASSERT_EQ(r.components.size(), 1u);
+    EXPECT_NEAR(r.components[0].removed_volume, *std::min_element(volumes.begin(), volumes.end()),
+                1e-12);
+    EXPECT_EQ(triangle_components(mesh).count, 2);
+    EXPECT_LT(mesh.count_live_triangles(), triangles);
+    EXPECT_TRUE(validate_mesh(mesh).empty());
+    plane.gone = std::numeric_limits<double>::infinity();
+    EXPECT_THROW(plane.validate(), std::invalid_argument);
+}
+
 TEST(ClipMesh, TorusCutAcrossItsHoleGetsAnAnnulus) {
     // Axis along x: the plane x = c (through the ring's centre circle) meets the torus in two
     // concentric circles; the cap is the annulus between them (the inner loop a hole of the

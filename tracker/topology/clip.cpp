@@ -58,6 +58,8 @@ void ClipPlane::validate() const {
         throw std::invalid_argument("ClipPlane.side: expected 0 (min) or 1 (max)");
     if (!std::isfinite(near) || !std::isfinite(far) || near == far)
         throw std::invalid_argument("ClipPlane.near, far: expected two different finite numbers");
+    if (std::isinf(gone))
+        throw std::invalid_argument("ClipPlane.gone: expected a finite number or NaN");
 }
 
 ClipReport clip_mesh(SurfaceMesh& mesh, const ClipPlane& plane) {
@@ -69,6 +71,7 @@ ClipReport clip_mesh(SurfaceMesh& mesh, const ClipPlane& plane) {
     const double dir = plane.side == 1 ? 1.0 : -1.0;
     const double t_near = std::min(dir * plane.near, dir * plane.far);
     const double t_far = std::max(dir * plane.near, dir * plane.far);
+    const double t_gone = std::isnan(plane.gone) ? t_near : std::min(dir * plane.gone, t_near);
     const int n_vertices = mesh.num_vertices();
 
     // 1. Where the cut goes, and the side of every vertex.
@@ -78,7 +81,7 @@ ClipReport clip_mesh(SurfaceMesh& mesh, const ClipPlane& plane) {
         if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty())
             continue;
         const double t = dir * mesh.position(vi)[a];
-        reaches = reaches || t > t_near;
+        reaches = reaches || t > t_gone;
         if (t >= t_near && t <= t_far)
             in_range.push_back(t);
     }
@@ -90,13 +93,24 @@ ClipReport clip_mesh(SurfaceMesh& mesh, const ClipPlane& plane) {
         return report;
     }
     report.position = dir * t_cut;
+    // Components wholly beyond t_gone count as beyond the cut throughout.
+    const Components components = triangle_components(mesh);
+    std::vector<char> gone(static_cast<size_t>(components.count), 1);
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        if (mesh.triangle_alive(ti))
+            for (int v : mesh.triangle(ti))
+                if (dir * mesh.position(v)[a] <= t_gone)
+                    gone[static_cast<size_t>(components.triangle_component[static_cast<size_t>(ti)])] = 0;
     std::vector<double> s(static_cast<size_t>(n_vertices), -1.0);  // > 0 beyond
-    bool any_beyond = false;
     for (int vi = 0; vi < n_vertices; ++vi)
-        if (mesh.vertex_alive(vi)) {
+        if (mesh.vertex_alive(vi))
             s[static_cast<size_t>(vi)] = dir * mesh.position(vi)[a] - t_cut;
-            any_beyond = any_beyond || s[static_cast<size_t>(vi)] > 0.0;
-        }
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        if (mesh.triangle_alive(ti) &&
+            gone[static_cast<size_t>(components.triangle_component[static_cast<size_t>(ti)])])
+            for (int v : mesh.triangle(ti))
+                s[static_cast<size_t>(v)] = std::max(s[static_cast<size_t>(v)], t_far - t_cut);
+    const bool any_beyond = std::any_of(s.begin(), s.end(), [](double si) { return si > 0.0; });
     if (!any_beyond)
         return report;
 
@@ -131,7 +145,6 @@ ClipReport clip_mesh(SurfaceMesh& mesh, const ClipPlane& plane) {
     // 3. The triangles: the removed part's volume per component (about a point on the plane, so
     //    the caps add nothing), and the cap's directed segments (from the crossing where the
     //    triangle's boundary comes back to the near side to the one where it leaves it).
-    const Components components = triangle_components(mesh);
     Vec3 origin = Vec3::Zero();
     for (const Crossing& x : crossings)
         origin += x.point;

@@ -5,7 +5,8 @@
 ///
 /// Where the cut goes: within the range given, at the middle of the widest gap between the
 /// vertices' coordinates along the axis, so no vertex lies on the plane and the new vertices are
-/// at least half that gap (along the axis) from the old ones.
+/// at least half that gap (along the axis) from the old ones. Components wholly beyond
+/// ClipPlane::gone go whole.
 ///
 /// How: every edge crossing the plane is split there (the new vertex exactly on the plane), the
 /// triangles beyond it are deleted with the vertices left without triangles, and the loops in
@@ -39,6 +40,10 @@ struct ClipPlane {
     /// that stays, near ≠ far).
     double near = 0.0;
     double far = 0.0;
+    /// A connected component lying wholly beyond this coordinate goes whole, even where it does
+    /// not reach the cut (what has left a box through its face; NaN: `near`). Taken as `near`
+    /// where it lies beyond it.
+    double gone = std::numeric_limits<double>::quiet_NaN();
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
 
