@@ -202,6 +202,57 @@ TEST(ClipMesh, ComponentsWhollyBeyondGoneGoWholeWhereverTheCutFalls) {
     EXPECT_THROW(plane.validate(), std::invalid_argument);
 }
 
+/// The four outward-facing triangles of the tetrahedron (p[i], p[j], p[k], p[l]).
+std::vector<Triangle> tetrahedron(const std::vector<Vec3>& p, int i, int j, int k, int l) {
+    const bool outward = (p[static_cast<size_t>(j)] - p[static_cast<size_t>(i)])
+                             .cross(p[static_cast<size_t>(k)] - p[static_cast<size_t>(i)])
+                             .dot(p[static_cast<size_t>(l)] - p[static_cast<size_t>(i)]) < 0.0;
+    if (!outward)
+        std::swap(j, k);
+    return {{i, j, k}, {i, l, j}, {j, l, k}, {i, k, l}};
+}
+
+TEST(ClipMesh, AnEdgeWithFourTrianglesMovesTheCutElsewhere) {
+    // Two tetrahedra touching along the edge from x = 0.3 to 0.7 (four triangles on it, as two
+    // sheets mid-merge). In the range [0.35, 0.9] the widest gap's middle, 0.525, would cut that
+    // edge; the cut goes to the next gap's, 0.8, where only two-triangle edges cross.
+    const std::vector<Vec3> p = {{0.3, 0, 0}, {0.7, 0, 0},    {1.0, 1, 0},
+                                 {0.5, 0.5, 1}, {1.0, -1, 0}, {0.5, -0.5, -1}};
+    std::vector<Triangle> triangles = tetrahedron(p, 0, 1, 2, 3);
+    for (const Triangle& t : tetrahedron(p, 0, 1, 4, 5))
+        triangles.push_back(t);
+    SurfaceMesh mesh(p, triangles);
+    ASSERT_EQ(mesh.edge_triangles(mesh.find_edge(0, 1)).size(), 4u);
+    ASSERT_GT(enclosed_volume(mesh), 0.0);
+    ClipPlane plane;
+    plane.axis = 0;
+    plane.side = 1;
+    plane.near = 0.35;
+    plane.far = 0.9;
+    const double before = enclosed_volume(mesh);
+    const ClipReport r = clip_mesh(mesh, plane);
+    ASSERT_TRUE(r.clipped) << r.deferred;
+    EXPECT_DOUBLE_EQ(r.position, 0.8);
+    EXPECT_EQ(r.edges_split, 6);
+    EXPECT_EQ(r.cap_triangles, 2);
+    EXPECT_EQ(mesh.edge_triangles(mesh.find_edge(0, 1)).size(), 4u);  // untouched
+    EXPECT_TRUE(validate_mesh(mesh).empty());
+    EXPECT_TRUE(is_intersection_free(mesh));
+    double removed = 0.0;
+    for (const ClippedComponent& c : r.components)
+        removed += c.removed_volume;
+    EXPECT_NEAR(enclosed_volume(mesh), before - removed, 1e-14);
+    // Where every position crosses that edge (all of the range and beyond lies along it), the
+    // mesh is left as it was and the report says why.
+    SurfaceMesh again(p, triangles);
+    plane.near = 0.32;
+    plane.far = 0.34;  // beyond: up to 0.38, still along the edge
+    const ClipReport refused = clip_mesh(again, plane);
+    EXPECT_FALSE(refused.clipped);
+    EXPECT_EQ(refused.deferred, "an edge crossing the plane has 4 triangles");
+    EXPECT_EQ(enclosed_volume(again), before);
+}
+
 TEST(ClipMesh, TorusCutAcrossItsHoleGetsAnAnnulus) {
     // Axis along x: the plane x = c (through the ring's centre circle) meets the torus in two
     // concentric circles; the cap is the annulus between them (the inner loop a hole of the

@@ -5,8 +5,9 @@
 ///
 /// Where the cut goes: within the range given, at the middle of the widest gap between the
 /// vertices' coordinates along the axis, so no vertex lies on the plane and the new vertices are
-/// at least half that gap (along the axis) from the old ones. Components wholly beyond
-/// ClipPlane::gone go whole.
+/// at least half that gap (along the axis) from the old ones. Where the cut cannot be made
+/// cleanly there (below), the next widest gaps are tried, then gaps further out, over twice the
+/// range's width beyond it. Components wholly beyond ClipPlane::gone go whole.
 ///
 /// How: every edge crossing the plane is split there (the new vertex exactly on the plane), the
 /// triangles beyond it are deleted with the vertices left without triangles, and the loops in
@@ -18,10 +19,11 @@
 ///
 /// Intersection-free: the remaining triangles lie in the closed near half-space and touch the
 /// plane only at the new vertices and the loop edges between them; the caps lie in the plane,
-/// inside the loops, which are disjoint. Nothing is changed when the cut cannot be made cleanly —
-/// an edge crossing the plane with other than two triangles, loops whose orientations or labels
-/// do not nest as two regions, a polygon the ear clipping cannot do — and the report says why (the
-/// caller tries again on a later step, where the cut falls elsewhere).
+/// inside the loops, which are disjoint. A cut that cannot be made cleanly — an edge crossing the
+/// plane with other than two triangles, loops whose orientations or labels do not nest as two
+/// regions, a polygon the ear clipping cannot do — is not made: the next position is tried, and
+/// when none will do the mesh is left as it was, the report says why, and the caller tries again
+/// on a later step.
 
 #include "tracker/mesh.h"
 
@@ -61,8 +63,8 @@ struct ClippedComponent {
 /// What clip_mesh() did.
 struct ClipReport {
     bool clipped = false;  ///< the mesh reached beyond the cut and was cut
-    /// Why nothing was done although the mesh reaches past the range's near end (empty if it
-    /// was done or there was nothing to do).
+    /// Why nothing was done although the mesh reaches past the range's near end, as the first
+    /// position tried failed (empty if a cut was made or there was nothing to do).
     std::string deferred;
     double position = std::numeric_limits<double>::quiet_NaN();  ///< the cut, along the axis
     int edges_split = 0;         ///< edges crossing the plane, split on it
