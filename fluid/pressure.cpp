@@ -1,6 +1,7 @@
 #include "fluid/pressure.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -80,9 +81,12 @@ void for_each_interior_face(const MacGrid& grid, int axis, Visit&& visit) {
 }
 
 /// Calls visit(axis, face index (i, j, k), the cell inside it, its coupling) for every boundary face
-/// of an outflow side of the box whose cell is an unknown: a Dirichlet face with p = the
-/// outflow's pressure on the face itself, half a cell from the cell's centre (coefficient 2/ρ of
-/// the cell's phase).
+/// of an outflow side of the box whose cell is an unknown of the face's ambient phase — the phase
+/// of most of its cells: a Dirichlet face with p = the outflow's pressure on the face itself,
+/// half a cell from the cell's centre (coefficient 2/ρ of the cell's phase). The faces of the
+/// cells of the other phase (a drop or a bubble on its way out) are left out: they keep the
+/// zero-gradient velocity they were given (a Neumann face, like a wall's), so what leaves does
+/// so at its own speed and its Laplace pressure is not pinned to the ambient's.
 template <class Visit>
 void for_each_outflow_face(const MacGrid& grid, const InterfaceInput& interface,
                            const PhaseOptions& phases, FluidMode mode,
@@ -97,15 +101,28 @@ void for_each_outflow_face(const MacGrid& grid, const InterfaceInput& interface,
             const int ni = axis == 0 ? 1 : faces.ni();
             const int nj = axis == 1 ? 1 : faces.nj();
             const int nk = axis == 2 ? 1 : faces.nk();
+            const auto cell_of = [&](int i, int j, int k) {
+                std::array<int, 3> cell = {i, j, k};
+                cell[static_cast<size_t>(axis)] = side == 0 ? 0 : grid.cells(axis) - 1;
+                return cell;
+            };
+            long long liquid = 0, total = 0;
             for (int k = 0; k < nk; ++k)
                 for (int j = 0; j < nj; ++j)
                     for (int i = 0; i < ni; ++i) {
-                        int face[3] = {i, j, k};
-                        int cell[3] = {i, j, k};
-                        face[axis] = side == 0 ? 0 : grid.cells(axis);
-                        cell[axis] = side == 0 ? 0 : grid.cells(axis) - 1;
+                        const std::array<int, 3> cell = cell_of(i, j, k);
+                        liquid += is_liquid(phi(cell[0], cell[1], cell[2])) ? 1 : 0;
+                        ++total;
+                    }
+            const bool ambient_liquid = 2 * liquid >= total;
+            for (int k = 0; k < nk; ++k)
+                for (int j = 0; j < nj; ++j)
+                    for (int i = 0; i < ni; ++i) {
+                        const std::array<int, 3> cell = cell_of(i, j, k);
+                        std::array<int, 3> face = {i, j, k};
+                        face[static_cast<size_t>(axis)] = side == 0 ? 0 : grid.cells(axis);
                         const double phi_cell = phi(cell[0], cell[1], cell[2]);
-                        if (!is_unknown(phi_cell, mode))
+                        if (!is_unknown(phi_cell, mode) || is_liquid(phi_cell) != ambient_liquid)
                             continue;
                         FaceCoupling coupling;
                         coupling.kind = side == 0 ? FaceCoupling::Kind::dirichlet_hi

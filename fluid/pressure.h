@@ -11,9 +11,12 @@
 /// Wall and inflow faces of the box are not unknowns: their stored normal velocity is kept (a
 /// Neumann condition). An outflow face (boundary.h) is a Dirichlet face with p = its pressure on
 /// the face, half a cell from its cell's centre: it adds 2/ρ of the cell's phase to the diagonal
-/// and its velocity takes the gradient like an interior face. In free_surface mode only liquid cells are unknowns; a face to a gas cell
-/// uses the ghost value that puts p = σκ at the θ-weighted interface position, adding β/θ to the
-/// diagonal (θ clamped below by min_liquid_fraction). Pressure in Pa.
+/// and its velocity takes the gradient like an interior face — where its cell holds the face's
+/// ambient phase (that of most of the face's cells); where a drop or a bubble is on its way out,
+/// the face keeps its zero-gradient velocity (Neumann), so the Laplace pressure inside it is not
+/// pinned to the ambient pressure. In free_surface mode only liquid cells are unknowns; a face to
+/// a gas cell uses the ghost value that puts p = σκ at the θ-weighted interface position, adding
+/// β/θ to the diagonal (θ clamped below by min_liquid_fraction). Pressure in Pa.
 
 #include <memory>
 #include <vector>
