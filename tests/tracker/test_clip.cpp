@@ -91,6 +91,16 @@ TEST(PolygonTriangulation, RefusesLoopsOfTheWrongOrientation) {
         triangulate_polygon(p, {{0, 1, 2, 3}, {{4, 5, 6, 7}}}).ok);  // counter-clockwise hole
 }
 
+/// The plane across `axis` removing `side` (1: x > cut) with the cut in [near, far].
+ClipPlane plane_at(int axis, int side, double near, double far) {
+    ClipPlane plane;
+    plane.axis = axis;
+    plane.side = side;
+    plane.near = near;
+    plane.far = far;
+    return plane;
+}
+
 SurfaceMesh mesh_of(const ShapePtr& shape, double edge) {
     ImplicitMeshOptions options;
     options.edge_length = edge;
@@ -126,11 +136,7 @@ void expect_clean_clip(SurfaceMesh& mesh, const ClipPlane& plane, int expected_c
 TEST(ClipMesh, SphereLosesItsCapAndIsClosedByADisc) {
     SurfaceMesh mesh = mesh_of(make_sphere({0, 0, 0}, 1.0), 0.1);
     const double before = enclosed_volume(mesh);
-    ClipPlane plane;
-    plane.axis = 0;
-    plane.side = 1;
-    plane.near = 0.45;
-    plane.far = 0.55;
+    ClipPlane plane = plane_at(0, 1, 0.45, 0.55);
     ClipReport r;
     expect_clean_clip(mesh, plane, 1, &r);
     // The removed cap of height h = 1 − x: π h² (3 − h) / 3, to the mesh's resolution.
@@ -142,11 +148,7 @@ TEST(ClipMesh, SphereLosesItsCapAndIsClosedByADisc) {
 TEST(ClipMesh, NothingBeyondTheRangeChangesNothing) {
     SurfaceMesh mesh = mesh_of(make_sphere({0, 0, 0}, 1.0), 0.2);
     const int triangles = mesh.count_live_triangles();
-    ClipPlane plane;
-    plane.axis = 2;
-    plane.side = 1;
-    plane.near = 1.1;
-    plane.far = 1.3;
+    ClipPlane plane = plane_at(2, 1, 1.1, 1.3);
     const ClipReport r = clip_mesh(mesh, plane);
     EXPECT_FALSE(r.clipped);
     EXPECT_TRUE(r.deferred.empty());
@@ -157,11 +159,7 @@ TEST(ClipMesh, AComponentWhollyBeyondIsRemovedWithItsVolume) {
     SurfaceMesh mesh =
         mesh_of(make_union({make_sphere({0, 0, 0}, 0.5), make_sphere({2, 0, 0}, 0.3)}), 0.08);
     const std::vector<double> volumes = component_volumes(mesh, triangle_components(mesh));
-    ClipPlane plane;
-    plane.axis = 0;
-    plane.side = 1;
-    plane.near = 1.0;
-    plane.far = 1.5;
+    ClipPlane plane = plane_at(0, 1, 1.0, 1.5);
     const ClipReport r = clip_mesh(mesh, plane);
     ASSERT_TRUE(r.clipped);
     EXPECT_EQ(r.components_removed, 1);
@@ -176,17 +174,14 @@ TEST(ClipMesh, AComponentWhollyBeyondIsRemovedWithItsVolume) {
 TEST(ClipMesh, ComponentsWhollyBeyondGoneGoWholeWhereverTheCutFalls) {
     // Three drops: one wholly past `gone` but short of the cut's range (goes whole), one across
     // `gone` and short of the range (stays as it is), one far inside (stays).
-    SurfaceMesh mesh = mesh_of(make_union({make_sphere({1.3, 0, 0}, 0.2), make_sphere({1.0, 1, 0}, 0.2),
-                                           make_sphere({0, 0, 0}, 0.3)}),
-                               0.05);
+    SurfaceMesh mesh =
+        mesh_of(make_union({make_sphere({1.3, 0, 0}, 0.2), make_sphere({1.0, 1, 0}, 0.2),
+                            make_sphere({0, 0, 0}, 0.3)}),
+                0.05);
     const std::vector<double> volumes = component_volumes(mesh, triangle_components(mesh));
     const int triangles = mesh.count_live_triangles();
-    ClipPlane plane;
-    plane.axis = 0;
-    plane.side = 1;
+    ClipPlane plane = plane_at(0, 1, 1.6, 1.8);
     plane.gone = 1.05;
-    plane.near = 1.6;
-    plane.far = 1.8;
     const ClipReport r = clip_mesh(mesh, plane);
     ASSERT_TRUE(r.clipped) << r.deferred;
     EXPECT_EQ(r.components_removed, 1);
@@ -216,7 +211,7 @@ TEST(ClipMesh, AnEdgeWithFourTrianglesMovesTheCutElsewhere) {
     // Two tetrahedra touching along the edge from x = 0.3 to 0.7 (four triangles on it, as two
     // sheets mid-merge). In the range [0.35, 0.9] the widest gap's middle, 0.525, would cut that
     // edge; the cut goes to the next gap's, 0.8, where only two-triangle edges cross.
-    const std::vector<Vec3> p = {{0.3, 0, 0}, {0.7, 0, 0},    {1.0, 1, 0},
+    const std::vector<Vec3> p = {{0.3, 0, 0},   {0.7, 0, 0},  {1.0, 1, 0},
                                  {0.5, 0.5, 1}, {1.0, -1, 0}, {0.5, -0.5, -1}};
     std::vector<Triangle> triangles = tetrahedron(p, 0, 1, 2, 3);
     for (const Triangle& t : tetrahedron(p, 0, 1, 4, 5))
@@ -224,11 +219,7 @@ TEST(ClipMesh, AnEdgeWithFourTrianglesMovesTheCutElsewhere) {
     SurfaceMesh mesh(p, triangles);
     ASSERT_EQ(mesh.edge_triangles(mesh.find_edge(0, 1)).size(), 4u);
     ASSERT_GT(enclosed_volume(mesh), 0.0);
-    ClipPlane plane;
-    plane.axis = 0;
-    plane.side = 1;
-    plane.near = 0.35;
-    plane.far = 0.9;
+    ClipPlane plane = plane_at(0, 1, 0.35, 0.9);
     const double before = enclosed_volume(mesh);
     const ClipReport r = clip_mesh(mesh, plane);
     ASSERT_TRUE(r.clipped) << r.deferred;
@@ -258,22 +249,14 @@ TEST(ClipMesh, TorusCutAcrossItsHoleGetsAnAnnulus) {
     // concentric circles; the cap is the annulus between them (the inner loop a hole of the
     // outer one), and what is left is still a ring.
     SurfaceMesh mesh = mesh_of(make_torus({0, 0, 0}, {1, 0, 0}, 1.0, 0.4), 0.08);
-    ClipPlane plane;
-    plane.axis = 0;
-    plane.side = 0;  // remove x < cut
-    plane.near = 0.05;
-    plane.far = -0.05;
+    ClipPlane plane = plane_at(0, 0, 0.05, -0.05);  // remove x < cut
     expect_clean_clip(mesh, plane, 1);
     EXPECT_EQ(euler_characteristic(mesh), 0);  // the half of the tube on x > c, still a ring
 }
 
 TEST(ClipMesh, TorusCutThroughBothArmsGetsTwoDiscs) {
     SurfaceMesh mesh = mesh_of(make_torus({0, 0, 0}, {0, 0, 1}, 1.0, 0.4), 0.08);
-    ClipPlane plane;
-    plane.axis = 1;
-    plane.side = 1;
-    plane.near = -0.1;
-    plane.far = 0.1;
+    ClipPlane plane = plane_at(1, 1, -0.1, 0.1);
     expect_clean_clip(mesh, plane, 1);
     EXPECT_EQ(euler_characteristic(mesh), 2);  // a bent tube capped at both ends
 }
@@ -284,11 +267,7 @@ TEST(ClipMesh, ShellCutOpenBecomesACup) {
     SurfaceMesh mesh =
         mesh_of(make_difference(make_sphere({0, 0, 0}, 1.0), make_sphere({0, 0, 0}, 0.6)), 0.08);
     ASSERT_EQ(triangle_components(mesh).count, 2);
-    ClipPlane plane;
-    plane.axis = 2;
-    plane.side = 1;
-    plane.near = 0.1;
-    plane.far = 0.2;
+    ClipPlane plane = plane_at(2, 1, 0.1, 0.2);
     expect_clean_clip(mesh, plane, 1);
     EXPECT_EQ(euler_characteristic(mesh), 2);
 }
@@ -306,11 +285,7 @@ TEST(ClipMesh, InvertedBubbleIsCappedWithItsOwnOrientation) {
     }
     mesh.compact();
     ASSERT_LT(enclosed_volume(mesh), 0.0);
-    ClipPlane plane;
-    plane.axis = 1;
-    plane.side = 1;
-    plane.near = -0.2;
-    plane.far = 0.0;
+    ClipPlane plane = plane_at(1, 1, -0.2, 0.0);
     expect_clean_clip(mesh, plane, 1);
     EXPECT_LT(enclosed_volume(mesh), 0.0);
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
@@ -325,11 +300,7 @@ TEST(ClipMesh, RepeatedCutsEatADropSliceBySlice) {
     const double start = enclosed_volume(mesh);
     double removed = 0.0;
     for (int slice = 0; slice < 12; ++slice) {
-        ClipPlane plane;
-        plane.axis = 0;
-        plane.side = 1;
-        plane.near = 0.9 - 0.2 * slice;
-        plane.far = plane.near + 0.05;
+        const ClipPlane plane = plane_at(0, 1, 0.9 - 0.2 * slice, 0.95 - 0.2 * slice);
         const ClipReport r = clip_mesh(mesh, plane);
         ASSERT_TRUE(r.deferred.empty()) << r.deferred;
         for (const ClippedComponent& c : r.components)
