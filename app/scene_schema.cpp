@@ -42,14 +42,16 @@ const std::vector<std::pair<std::string, fluid::BoundaryType>> BOUNDARY_TYPES = 
     {"free_slip", fluid::BoundaryType::free_slip},
     {"no_slip", fluid::BoundaryType::no_slip},
     {"inflow", fluid::BoundaryType::inflow},
-    {"outflow", fluid::BoundaryType::outflow}};
+    {"outflow", fluid::BoundaryType::outflow},
+    {"periodic", fluid::BoundaryType::periodic}};
 const char* const FACE_NAMES[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
 
 template <typename V>
 void visit_fields(V& v, fluid::FaceBoundary& o) {
     enum_field(v, "type", o.type, BOUNDARY_TYPES,
-               "free_slip or no_slip wall, inflow (a prescribed velocity into the box) or outflow "
-               "(fixed pressure, zero-gradient velocity)");
+               "free_slip or no_slip wall, inflow (a prescribed velocity into the box), outflow "
+               "(fixed pressure, zero-gradient velocity) or periodic (with the opposite face; "
+               "not available in the fluid step yet)");
     v.vec3("velocity", o.velocity, Range::any(), "m/s",
            "no_slip: the wall's velocity along itself (a moving wall; normal component 0)");
     v.number("pressure", o.pressure, Range::any(), "Pa", "outflow: the pressure on the face");

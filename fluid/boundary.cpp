@@ -28,7 +28,8 @@ void check_side(int axis, int side) {
 bool walled_axis(const BoundaryOptions& boundaries, int b) {
     for (int side = 0; side < 2; ++side) {
         const BoundaryType type = boundaries.at(b, side);
-        if (type == BoundaryType::free_slip || type == BoundaryType::outflow)
+        if (type == BoundaryType::free_slip || type == BoundaryType::outflow ||
+            type == BoundaryType::periodic)
             return false;
     }
     return true;
@@ -103,6 +104,22 @@ const FaceBoundary& BoundaryOptions::face(int axis, int side) const {
     return *faces[axis][side];
 }
 
+const char* boundary_type_name(BoundaryType type) {
+    switch (type) {
+        case BoundaryType::free_slip:
+            return "free_slip";
+        case BoundaryType::no_slip:
+            return "no_slip";
+        case BoundaryType::inflow:
+            return "inflow";
+        case BoundaryType::outflow:
+            return "outflow";
+        case BoundaryType::periodic:
+            return "periodic";
+    }
+    return "unknown";
+}
+
 bool BoundaryOptions::moving() const {
     for (int axis = 0; axis < 3; ++axis)
         for (int side = 0; side < 2; ++side)
@@ -146,11 +163,20 @@ void BoundaryOptions::validate() const {
             const FaceBoundary& f = face(axis, side);
             const std::string name = FACE_NAMES[axis][side];
             if (f.type != BoundaryType::free_slip && f.type != BoundaryType::no_slip &&
-                f.type != BoundaryType::inflow && f.type != BoundaryType::outflow)
+                f.type != BoundaryType::inflow && f.type != BoundaryType::outflow &&
+                f.type != BoundaryType::periodic)
                 throw std::invalid_argument(
                     name +
-                    "/type: unknown boundary type (use free_slip, no_slip, inflow or "
-                    "outflow)");
+                    "/type: unknown boundary type (use free_slip, no_slip, inflow, outflow or "
+                    "periodic)");
+            const BoundaryType opposite = at(axis, 1 - side);
+            if ((f.type == BoundaryType::periodic) != (opposite == BoundaryType::periodic))
+                throw std::invalid_argument(
+                    std::string(FACE_NAMES[axis][1]) + ": " + FACE_NAMES[axis][0] + " is " +
+                    boundary_type_name(at(axis, 0)) + " and " + FACE_NAMES[axis][1] + " " +
+                    boundary_type_name(at(axis, 1)) +
+                    ": a periodic face is paired with the opposite face, which must be periodic "
+                    "too");
             if (!f.velocity.allFinite())
                 throw std::invalid_argument(name + "/velocity: expected finite numbers (m/s)");
             if (f.velocity[axis] != 0.0)
@@ -161,10 +187,7 @@ void BoundaryOptions::validate() const {
             if (f.velocity != Eigen::Vector3d::Zero() && f.type != BoundaryType::no_slip)
                 throw std::invalid_argument(
                     name + "/velocity: only a no_slip wall drags the fluid along itself; " + name +
-                    " is " +
-                    (f.type == BoundaryType::free_slip
-                         ? "free_slip"
-                         : (f.type == BoundaryType::inflow ? "an inflow" : "an outflow")));
+                    " is " + boundary_type_name(f.type));
             if (!std::isfinite(f.pressure))
                 throw std::invalid_argument(name + "/pressure: expected a finite number (Pa)");
             const InflowOptions& in = f.inflow;
@@ -252,6 +275,15 @@ void apply_boundary_velocity(MacGrid& grid, const BoundaryOptions& boundaries, d
         for (int side = 0; side < 2; ++side) {
             const BoundaryType type = boundaries.at(axis, side);
             const int inward = side == 0 ? 1 : -1;
+            if (type == BoundaryType::periodic) {
+                if (side == 1)  // the max face is the min face's copy
+                    for_each_boundary_face(grid, axis, side, [&](int i, int j, int k) {
+                        int first[3] = {i, j, k};
+                        first[axis] = 0;
+                        faces(i, j, k) = faces(first[0], first[1], first[2]);
+                    });
+                continue;
+            }
             for_each_boundary_face(grid, axis, side, [&](int i, int j, int k) {
                 if (type == BoundaryType::outflow) {
                     int next[3] = {i, j, k};

@@ -9,7 +9,14 @@
 ///   and the rest of the face is a no-slip wall;
 /// - an `outflow`: the pressure fixed on the face (FaceBoundary::pressure), the velocity of zero
 ///   normal gradient (the normal face velocity is an unknown of the projection; the tangential
-///   velocity feels no shear from the face).
+///   velocity feels no shear from the face);
+/// - `periodic`, on both faces of an axis: what leaves through one face enters through the other.
+///   The grid face on the min side is the unknown and the one on the max side its copy
+///   (apply_boundary_velocity() keeps them equal); cell n−1 and cell 0 are neighbours across it.
+///   Handled so far by the pressure projection (pressure.h; PoissonMatrix::periodic and its
+///   MIC(0), multigrid and Eigen solvers), gravity and apply_boundary_velocity(); advection,
+///   viscosity, extrapolation and the interface do not wrap yet, so FluidOptions::validate()
+///   refuses periodic faces (issue 39).
 /// On the MAC grid the normal velocity of a face lives on the boundary faces of the grid (see
 /// mac_grid.h); walls and inflows set it, outflows leave it to the pressure projection.
 
@@ -20,7 +27,10 @@
 namespace meniscus::fluid {
 
 /// What a face of the box is (see the file comment).
-enum class BoundaryType { free_slip, no_slip, inflow, outflow };
+enum class BoundaryType { free_slip, no_slip, inflow, outflow, periodic };
+
+/// The scene name of `type` ("free_slip", ...).
+const char* boundary_type_name(BoundaryType type);
 
 /// Profile of an inflow's normal speed over its region.
 enum class InflowProfile {
@@ -90,6 +100,8 @@ struct BoundaryOptions {
     bool open() const { return has(BoundaryType::outflow); }
     /// True if any face is an inflow.
     bool inflow() const { return has(BoundaryType::inflow); }
+    /// True if the faces of `axis` are periodic (validate() checks that both are).
+    bool periodic(int axis) const { return at(axis, 0) == BoundaryType::periodic; }
     /// The same faces with homogeneous data: walls at rest, inflows at zero speed, outflows at
     /// zero pressure (for the solves of velocity and pressure increments).
     BoundaryOptions at_rest() const;
@@ -97,8 +109,9 @@ struct BoundaryOptions {
     static BoundaryOptions all(BoundaryType type);
     /// Throws std::invalid_argument naming the field ("x_min/inflow/radius", ...) if an enum
     /// holds an unknown value, a number is not finite or out of range, a velocity has a normal
-    /// component or belongs to a face that is not a no-slip wall, or liquid flows in through an
-    /// inflow of a box with no outflow face (it would have nowhere to go).
+    /// component or belongs to a face that is not a no-slip wall, a periodic face is paired with
+    /// a face that is not periodic, or liquid flows in through an inflow of a box with no outflow
+    /// face (it would have nowhere to go).
     void validate() const;
 };
 
@@ -122,7 +135,7 @@ double face_inflow_velocity(const BoundaryOptions& boundaries, int axis, int sid
 
 /// Sets the normal velocity on every boundary face of `grid`: walls 0, inflows their profile
 /// (face_inflow_velocity()), outflows the velocity of the interior face next to them (zero
-/// normal gradient).
+/// normal gradient), the max face of a periodic pair that of the min face (the same face).
 /// `time` (s) is that of the velocities (a pulsed inflow's phase).
 void apply_boundary_velocity(MacGrid& grid, const BoundaryOptions& boundaries, double time = 0.0);
 

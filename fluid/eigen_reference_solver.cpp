@@ -44,12 +44,13 @@ SolveResult solve_eigen_ic_cg(const PoissonMatrix& matrix, const std::vector<dou
                         triplets.emplace_back(unknown[other], row, value);
                     }
                 };
-                if (i + 1 < ni)
-                    couple(matrix.diag.index(i + 1, j, k), matrix.off_x[c]);
-                if (j + 1 < nj)
-                    couple(matrix.diag.index(i, j + 1, k), matrix.off_y[c]);
-                if (k + 1 < nk)
-                    couple(matrix.diag.index(i, j, k + 1), matrix.off_z[c]);
+                // The last cell of a periodic axis couples to the first (the seam).
+                if (i + 1 < ni || matrix.periodic[0])
+                    couple(matrix.diag.index((i + 1) % ni, j, k), matrix.off_x[c]);
+                if (j + 1 < nj || matrix.periodic[1])
+                    couple(matrix.diag.index(i, (j + 1) % nj, k), matrix.off_y[c]);
+                if (k + 1 < nk || matrix.periodic[2])
+                    couple(matrix.diag.index(i, j, (k + 1) % nk), matrix.off_z[c]);
             }
         }
     }

@@ -59,6 +59,15 @@ void FluidOptions::validate() const {
     } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(std::string("boundaries/") + e.what());
     }
+    for (const char* axis : {"x", "y", "z"}) {
+        const int a = axis[0] - 'x';
+        if (boundaries.periodic(a))
+            throw std::invalid_argument(
+                std::string("boundaries/") + axis +
+                "_min: periodic faces are not available in the fluid step yet: the pressure "
+                "projection handles them, advection, viscosity, extrapolation and the surface "
+                "mesh do not (issue 39); use free_slip walls");
+    }
     advection.validate();
     viscosity.validate();
     pressure.validate();
@@ -108,9 +117,9 @@ void FluidSolver::split_step(double dt, const InterfaceInput& interface, StepRes
     // Viscosity before gravity: the body force is then balanced by the pressure of the same
     // projection, so a fluid at rest in hydrostatic equilibrium stays exactly at rest.
     PhaseClock clock;
-    result.viscosity = m_viscosity.solve(m_grid, interface, m_options.phases, m_options.mode,
-                                         m_options.boundaries, dt, m_options.viscosity,
-                                         m_options.pressure.min_liquid_fraction);
+    result.viscosity =
+        m_viscosity.solve(m_grid, interface, m_options.phases, m_options.mode, m_options.boundaries,
+                          dt, m_options.viscosity, m_options.pressure.min_liquid_fraction);
     clock.lap_into(result.timings.viscosity);
 
     apply_gravity(m_grid, m_options.gravity, dt, m_options.boundaries);
@@ -125,8 +134,7 @@ void FluidSolver::split_step(double dt, const InterfaceInput& interface, StepRes
     result.timings.pressure_solve += projection.solve_time;
 }
 
-void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
-                                   StepResult& result) {
+void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, StepResult& result) {
     const PhaseOptions& phases = m_options.phases;
     const FluidMode mode = m_options.mode;
     const ViscousPressureOptions& scheme = m_options.viscous_pressure;
@@ -135,10 +143,10 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
     // The increments are homogeneous: walls at rest, inflows still, outflows at zero pressure.
     const BoundaryOptions increment_boundaries = boundaries.at_rest();
     const bool implicit_tension = surface && surface->active();
-    const bool viscous = (m_options.viscosity.enabled &&
-                          (phases.mu_liquid > 0.0 ||
-                           (mode == FluidMode::two_phase && phases.mu_gas > 0.0))) ||
-                         implicit_tension;
+    const bool viscous =
+        (m_options.viscosity.enabled &&
+         (phases.mu_liquid > 0.0 || (mode == FluidMode::two_phase && phases.mu_gas > 0.0))) ||
+        implicit_tension;
     // Without viscosity the projection alone already is the coupled step.
     const int max_iterations =
         scheme.coupling == ViscousPressureCoupling::coupled && viscous ? scheme.max_passes : 0;
@@ -160,8 +168,8 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
         // (hydrostatic plus Laplace), so that rest is exact from the first step.
         MacGrid body(m_grid.nx(), m_grid.ny(), m_grid.nz(), m_grid.dx(), m_grid.origin());
         apply_gravity(body, m_options.gravity, dt, boundaries);
-        add_solve(result.pressure, project(body, interface, phases, mode, dt,
-                                           m_options.pressure, m_pressure, boundaries)
+        add_solve(result.pressure, project(body, interface, phases, mode, dt, m_options.pressure,
+                                           m_pressure, boundaries)
                                        .solve);
     }
     carry_pressure_to_new_phase(m_was_liquid, interface, phases, mode, m_pressure);
@@ -188,8 +196,8 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
             x = -x;
         // The velocity scale: the flow's, the body force's over the step, or (at rest without
         // gravity) a displacement of RESTING_CELLS_PER_STEP cells per step.
-        const double velocity_floor = std::max(m_options.gravity.norm() * dt,
-                                               RESTING_CELLS_PER_STEP * dx / dt);
+        const double velocity_floor =
+            std::max(m_options.gravity.norm() * dt, RESTING_CELLS_PER_STEP * dx / dt);
         // The final projection removes what divergence the passes leave; it then differs from
         // the coupled velocity by the viscous part of A⁻¹, about D/(1 + D) of its own change
         // (D = νΔt/Δx², the larger phase's). The passes stop once that estimate is small.
@@ -228,9 +236,9 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
                                            m_options.pressure, increment_boundaries);
             clock.lap_into(result.timings.pressure_build);
             poisson = std::make_unique<PressureSystemSolver>(system, m_options.pressure);
-            add_solve(result.pressure, apply_cahouet_chabard(system, *poisson, scheme.preconditioner,
-                                                             interface, phases, mode, dt, dx, r,
-                                                             z));
+            add_solve(result.pressure,
+                      apply_cahouet_chabard(system, *poisson, scheme.preconditioner, interface,
+                                            phases, mode, dt, dx, r, z));
             direction.resize(m_grid.nx(), m_grid.ny(), m_grid.nz(), 0.0);
             direction.storage() = z;
             rz = dot(r, z);
@@ -243,10 +251,10 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
                 impulse.velocity(axis).fill(0.0);
             apply_pressure_gradient(impulse, interface, increment_phases, mode, dt,
                                     m_options.pressure, direction, increment_boundaries);
-            add_solve(result.viscosity,
-                      m_viscosity.solve(impulse, interface, phases, mode, increment_boundaries, dt,
-                                        m_options.viscosity,
-                                        m_options.pressure.min_liquid_fraction));
+            add_solve(
+                result.viscosity,
+                m_viscosity.solve(impulse, interface, phases, mode, increment_boundaries, dt,
+                                  m_options.viscosity, m_options.pressure.min_liquid_fraction));
             clock.lap_into(result.timings.viscosity);
             q = unknown_divergence(impulse, interface, mode);  // T s
             const double curvature = dot(direction.storage(), q);
@@ -271,8 +279,8 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
             result.converged_passes = result.pass_change <= scheme.pass_tolerance;
             if (!result.converged_passes) {
                 add_solve(result.pressure,
-                          apply_cahouet_chabard(system, *poisson, scheme.preconditioner,
-                                                interface, phases, mode, dt, dx, r, z));
+                          apply_cahouet_chabard(system, *poisson, scheme.preconditioner, interface,
+                                                phases, mode, dt, dx, r, z));
                 const double rz_new = dot(r, z);
                 const double beta = rz_new / rz;
                 rz = rz_new;
@@ -285,9 +293,9 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface,
 
     // The projection of what is left: u divergence-free to the pressure solver's tolerance.
     clock = PhaseClock();
-    const ProjectionResult projection = project(m_grid, interface, increment_phases, mode, dt,
-                                                m_options.pressure, m_increment,
-                                                increment_boundaries);
+    const ProjectionResult projection =
+        project(m_grid, interface, increment_phases, mode, dt, m_options.pressure, m_increment,
+                increment_boundaries);
     for (std::size_t c = 0; c < m_pressure.size(); ++c)
         m_pressure[c] += m_increment[c];
     if (projection.singular)

@@ -11,9 +11,12 @@ void apply_gravity(MacGrid& grid, const Eigen::Vector3d& gravity, double dt,
         }
         Array3<double>& faces = grid.velocity(axis);
         const int n_axis = grid.cells(axis);
-        // Outflow faces are momentum unknowns like interior ones; walls and inflows are fixed.
-        const bool open_min = boundaries.at(axis, 0) == BoundaryType::outflow;
-        const bool open_max = boundaries.at(axis, 1) == BoundaryType::outflow;
+        // Outflow faces are momentum unknowns like interior ones, and so are both copies of a
+        // periodic face; walls and inflows are fixed.
+        const bool open_min =
+            boundaries.at(axis, 0) == BoundaryType::outflow || boundaries.periodic(axis);
+        const bool open_max =
+            boundaries.at(axis, 1) == BoundaryType::outflow || boundaries.periodic(axis);
         for (int k = 0; k < faces.nk(); ++k) {
             for (int j = 0; j < faces.nj(); ++j) {
                 for (int i = 0; i < faces.ni(); ++i) {

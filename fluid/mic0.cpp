@@ -15,15 +15,17 @@ void Mic0Options::validate() const {
 }
 
 Mic0Preconditioner::Mic0Preconditioner(const PoissonMatrix& matrix, const Mic0Options& options)
-    : m_matrix(matrix) {
+    : m_unwrapped(matrix.any_periodic() ? std::make_unique<PoissonMatrix>(matrix.without_wrap())
+                                        : nullptr),
+      m_matrix(m_unwrapped ? *m_unwrapped : matrix) {
     options.validate();
     const int ni = matrix.ni(), nj = matrix.nj(), nk = matrix.nk();
     const std::size_t sj = static_cast<std::size_t>(ni);
     const std::size_t sk = static_cast<std::size_t>(ni) * nj;
-    const double* a_d = matrix.diag.data();
-    const double* a_x = matrix.off_x.data();
-    const double* a_y = matrix.off_y.data();
-    const double* a_z = matrix.off_z.data();
+    const double* a_d = m_matrix.diag.data();
+    const double* a_x = m_matrix.off_x.data();
+    const double* a_y = m_matrix.off_y.data();
+    const double* a_z = m_matrix.off_z.data();
     m_inverse_pivot.assign(matrix.size(), 0.0);
     double* pivot = m_inverse_pivot.data();
     const double tau = options.tuning;

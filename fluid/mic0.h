@@ -1,6 +1,7 @@
 #pragma once
 /// \file Modified incomplete Cholesky MIC(0) preconditioner for the 7-point Poisson matrix.
 
+#include <memory>
 #include <vector>
 
 #include "fluid/pcg.h"
@@ -18,7 +19,9 @@ struct Mic0Options {
 };
 
 /// MIC(0) preconditioner: A ≈ L Lᵀ with L having A's sparsity, built once per matrix. The
-/// factorisation and the two triangular solves are sequential (lexicographic order).
+/// factorisation and the two triangular solves are sequential (lexicographic order). Couplings
+/// across periodic seams are left out of L (it factorises PoissonMatrix::without_wrap(), whose
+/// seam rows are diagonally dominant): a symmetric positive definite approximation still.
 class Mic0Preconditioner final : public Preconditioner {
 public:
     /// Factorises `matrix`; keeps a reference to it (the matrix must outlive this object).
@@ -27,8 +30,9 @@ public:
     void apply(const std::vector<double>& r, std::vector<double>& z) const override;
 
 private:
-    const PoissonMatrix& m_matrix;
-    std::vector<double> m_inverse_pivot;  ///< 1/L_ii per cell, 0 on inactive cells
+    std::unique_ptr<PoissonMatrix> m_unwrapped;  ///< without_wrap() of a periodic matrix, or null
+    const PoissonMatrix& m_matrix;               ///< the caller's matrix, or *m_unwrapped
+    std::vector<double> m_inverse_pivot;         ///< 1/L_ii per cell, 0 on inactive cells
 };
 
 }  // namespace meniscus::fluid

@@ -23,7 +23,9 @@ constexpr double END_FACE_WEIGHT = 0.5;
 
 using AxisTransfer = MultigridPreconditioner::AxisTransfer;
 
-AxisTransfer make_axis_transfer(int fine_n) {
+/// The transfer along an axis of `fine_n` cells; along a `periodic` axis the fine cells at either
+/// end also interpolate from the coarse cell across the seam.
+AxisTransfer make_axis_transfer(int fine_n, bool periodic) {
     const int coarse_n = (fine_n + 1) / 2;
     AxisTransfer t;
     for (int s = 0; s < 2; ++s) {
@@ -43,7 +45,9 @@ AxisTransfer make_axis_transfer(int fine_n) {
     };
     for (int i = 0; i < fine_n; ++i) {
         const int parent = i / 2;
-        const int other = (i % 2 == 0) ? parent - 1 : parent + 1;
+        int other = (i % 2 == 0) ? parent - 1 : parent + 1;
+        if (periodic)
+            other = (other + coarse_n) % coarse_n;
         if (other < 0 || other >= coarse_n) {
             t.prolong_cell[0][i] = parent;
             t.prolong_weight[0][i] = 1.0;
@@ -64,13 +68,14 @@ AxisTransfer make_axis_transfer(int fine_n) {
 /// Dirichlet part of the diagonal of fine cell c: A_cc − Σ |off-diagonals| ≥ 0.
 double dirichlet_excess(const PoissonMatrix& a, int i, int j, int k) {
     const std::size_t c = a.diag.index(i, j, k);
+    // off_*(c) is 0 at the far end of a bounded axis and the seam's coupling on a periodic one.
     double excess = a.diag[c] + a.off_x[c] + a.off_y[c] + a.off_z[c];
-    if (i > 0)
-        excess += a.off_x(i - 1, j, k);
-    if (j > 0)
-        excess += a.off_y(i, j - 1, k);
-    if (k > 0)
-        excess += a.off_z(i, j, k - 1);
+    if (i > 0 || a.periodic[0])
+        excess += a.off_x(i > 0 ? i - 1 : a.ni() - 1, j, k);
+    if (j > 0 || a.periodic[1])
+        excess += a.off_y(i, j > 0 ? j - 1 : a.nj() - 1, k);
+    if (k > 0 || a.periodic[2])
+        excess += a.off_z(i, j, k > 0 ? k - 1 : a.nk() - 1);
     return std::max(excess, 0.0);
 }
 
@@ -85,9 +90,14 @@ double dirichlet_excess(const PoissonMatrix& a, int i, int j, int k) {
 /// PCG iterations on such systems. A line whose middle face is closed (an inactive neighbour in
 /// free-surface mode) carries nothing; closed or missing end faces are left out of the average.
 double coarse_coupling(const PoissonMatrix& fine, int axis, int ii, int jj, int kk) {
-    const Array3<double>& off = axis == 0 ? fine.off_x : (axis == 1 ? fine.off_y : fine.off_z);
+    const Array3<double>& off = fine.off(axis);
     const std::array<int, 3> fine_n = {fine.ni(), fine.nj(), fine.nk()};
     const std::array<int, 3> base = {2 * ii, 2 * jj, 2 * kk};
+    const int n = fine_n[axis];
+    // The lower coarse cell's last fine cell and the upper one's first: across a periodic seam
+    // (ii the last coarse cell) the upper is coarse cell 0, and the lower may hold one fine cell.
+    const int lower_last = std::min(base[axis] + 1, n - 1);
+    const int upper_first = (lower_last + 1) % n;
     const int t1 = (axis + 1) % 3;
     const int t2 = (axis + 2) % 3;
     double total = 0.0;
@@ -96,20 +106,24 @@ double coarse_coupling(const PoissonMatrix& fine, int axis, int ii, int jj, int 
             std::array<int, 3> face = base;
             face[t1] = a;
             face[t2] = b;
-            const double middle =
-                -off(face[0] + (axis == 0), face[1] + (axis == 1), face[2] + (axis == 2));
+            const auto beta_at = [&](int along) {
+                std::array<int, 3> at = face;
+                at[axis] = along;
+                return -off(at[0], at[1], at[2]);
+            };
+            const double middle = beta_at(lower_last);
             if (middle <= 0.0) {
                 continue;
             }
             double weighted = middle;
             double weights = 1.0;
-            for (int step : {0, 2}) {
-                std::array<int, 3> end = face;
-                end[axis] = base[axis] + step;
-                if (end[axis] + 1 >= fine_n[axis]) {
+            // The inner faces of the two coarse cells, where they hold two fine cells.
+            for (int end : {lower_last > base[axis] ? base[axis] : -1,
+                            upper_first + 1 < n ? upper_first : -1}) {
+                if (end < 0) {
                     continue;
                 }
-                const double beta = -off(end[0], end[1], end[2]);
+                const double beta = beta_at(end);
                 if (beta > 0.0) {
                     weighted += END_FACE_WEIGHT * beta;
                     weights += END_FACE_WEIGHT;
@@ -121,10 +135,16 @@ double coarse_coupling(const PoissonMatrix& fine, int axis, int ii, int jj, int 
     return -COARSE_FACE_SCALE * total;
 }
 
+/// The coarse matrix of `fine`. A periodic axis stays periodic while the coarse level has at
+/// least 3 cells along it; with 2 the seam's coupling joins the same two cells as the inner face
+/// and is added to it, with 1 it would couple the cell to itself and is left out.
 void build_coarse_matrix(const PoissonMatrix& fine, PoissonMatrix& coarse) {
     const int fi = fine.ni(), fj = fine.nj(), fk = fine.nk();
-    const int ci = (fi + 1) / 2, cj = (fj + 1) / 2, ck = (fk + 1) / 2;
+    const std::array<int, 3> cn = {(fi + 1) / 2, (fj + 1) / 2, (fk + 1) / 2};
+    const int ci = cn[0], cj = cn[1], ck = cn[2];
     coarse.resize(ci, cj, ck);
+    for (std::size_t axis = 0; axis < 3; ++axis)
+        coarse.periodic[axis] = fine.periodic[axis] && cn[axis] >= 3;
     tbb::parallel_for(tbb::blocked_range<int>(0, ck), [&](const tbb::blocked_range<int>& range) {
         for (int kk = range.begin(); kk != range.end(); ++kk) {
             for (int jj = 0; jj < cj; ++jj) {
@@ -140,37 +160,87 @@ void build_coarse_matrix(const PoissonMatrix& fine, PoissonMatrix& coarse) {
                         }
                     }
                     coarse.diag(ii, jj, kk) = COARSE_FACE_SCALE * excess;
-                    if (ii + 1 < ci)
-                        coarse.off_x(ii, jj, kk) = coarse_coupling(fine, 0, ii, jj, kk);
-                    if (jj + 1 < cj)
-                        coarse.off_y(ii, jj, kk) = coarse_coupling(fine, 1, ii, jj, kk);
-                    if (kk + 1 < ck)
-                        coarse.off_z(ii, jj, kk) = coarse_coupling(fine, 2, ii, jj, kk);
+                    const std::array<int, 3> at = {ii, jj, kk};
+                    for (int axis = 0; axis < 3; ++axis) {
+                        const auto a = static_cast<std::size_t>(axis);
+                        const bool last = at[a] + 1 == cn[a];
+                        if (!last || coarse.periodic[a])
+                            coarse.off(axis)(ii, jj, kk) = coarse_coupling(fine, axis, ii, jj, kk);
+                    }
                 }
             }
         }
     });
+    for (int axis = 0; axis < 3; ++axis) {
+        const auto a = static_cast<std::size_t>(axis);
+        if (!fine.periodic[a] || cn[a] != 2)
+            continue;
+        Array3<double>& off = coarse.off(axis);
+        for (int kk = 0; kk < (axis == 2 ? 1 : ck); ++kk)
+            for (int jj = 0; jj < (axis == 1 ? 1 : cj); ++jj)
+                for (int ii = 0; ii < (axis == 0 ? 1 : ci); ++ii) {
+                    std::array<int, 3> seam = {ii, jj, kk};
+                    seam[a] = 1;
+                    off(ii, jj, kk) += coarse_coupling(fine, axis, seam[0], seam[1], seam[2]);
+                }
+    }
     // Diagonal = Dirichlet part + Σ |couplings| (row sums of the Neumann part vanish).
     for (int kk = 0; kk < ck; ++kk) {
         for (int jj = 0; jj < cj; ++jj) {
             for (int ii = 0; ii < ci; ++ii) {
                 double sum = -(coarse.off_x(ii, jj, kk) + coarse.off_y(ii, jj, kk) +
                                coarse.off_z(ii, jj, kk));
-                if (ii > 0)
-                    sum -= coarse.off_x(ii - 1, jj, kk);
-                if (jj > 0)
-                    sum -= coarse.off_y(ii, jj - 1, kk);
-                if (kk > 0)
-                    sum -= coarse.off_z(ii, jj, kk - 1);
+                if (ii > 0 || coarse.periodic[0])
+                    sum -= coarse.off_x(ii > 0 ? ii - 1 : ci - 1, jj, kk);
+                if (jj > 0 || coarse.periodic[1])
+                    sum -= coarse.off_y(ii, jj > 0 ? jj - 1 : cj - 1, kk);
+                if (kk > 0 || coarse.periodic[2])
+                    sum -= coarse.off_z(ii, jj, kk > 0 ? kk - 1 : ck - 1);
                 coarse.diag(ii, jj, kk) += sum;
             }
         }
     }
 }
 
-/// One red–black Gauss–Seidel half sweep over cells with (i + j + k) % 2 == colour.
+/// Index of cell (i, j, k) within a plane normal to `axis`.
+inline std::size_t plane_index(int axis, int i, int j, int k, int ni, int nj) {
+    if (axis == 0)
+        return static_cast<std::size_t>(j) + static_cast<std::size_t>(nj) * k;
+    if (axis == 1)
+        return static_cast<std::size_t>(i) + static_cast<std::size_t>(ni) * k;
+    return static_cast<std::size_t>(i) + static_cast<std::size_t>(ni) * j;
+}
+
+void take_seam_planes(const PoissonMatrix& a, const std::vector<double>& x, SeamPlanes& seams) {
+    const std::array<int, 3> n = {a.ni(), a.nj(), a.nk()};
+    for (int axis = 0; axis < 3; ++axis) {
+        const auto ax = static_cast<std::size_t>(axis);
+        if (!a.periodic[ax])
+            continue;
+        const std::size_t plane = a.size() / static_cast<std::size_t>(n[ax]);
+        seams.first[ax].resize(plane);
+        seams.last[ax].resize(plane);
+        std::array<int, 3> hi = n;  // the plane's range, along `axis` one cell
+        hi[ax] = 1;
+        for (int side = 0; side < 2; ++side) {
+            std::vector<double>& out = side == 0 ? seams.first[ax] : seams.last[ax];
+            const int along = side == 0 ? 0 : n[ax] - 1;
+            for (int k = 0; k < hi[2]; ++k)
+                for (int j = 0; j < hi[1]; ++j)
+                    for (int i = 0; i < hi[0]; ++i) {
+                        std::array<int, 3> cell = {i, j, k};
+                        cell[ax] = along;
+                        out[plane_index(axis, i, j, k, n[0], n[1])] =
+                            x[a.diag.index(cell[0], cell[1], cell[2])];
+                    }
+        }
+    }
+}
+
+/// One red–black Gauss–Seidel half sweep over cells with (i + j + k) % 2 == colour. Neighbours
+/// across a periodic seam are read from `seams` (take_seam_planes() of x before the sweep).
 void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::vector<double>& x,
-                   int colour) {
+                   int colour, SeamPlanes& seams) {
     const int ni = a.ni(), nj = a.nj(), nk = a.nk();
     const std::size_t sj = static_cast<std::size_t>(ni);
     const std::size_t sk = static_cast<std::size_t>(ni) * nj;
@@ -180,6 +250,9 @@ void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::ve
     const double* a_z = a.off_z.data();
     const double* bv = b.data();
     double* xv = x.data();
+    const bool px = a.periodic[0], py = a.periodic[1], pz = a.periodic[2];
+    if (a.any_periodic())
+        take_seam_planes(a, x, seams);
     tbb::parallel_for(tbb::blocked_range<int>(0, nk), [&](const tbb::blocked_range<int>& range) {
         for (int k = range.begin(); k != range.end(); ++k) {
             for (int j = 0; j < nj; ++j) {
@@ -192,16 +265,30 @@ void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::ve
                     double sum = bv[c];
                     if (i + 1 < ni)
                         sum -= a_x[c] * xv[c + 1];
+                    else if (px)
+                        sum -= a_x[c] * seams.first[0][plane_index(0, i, j, k, ni, nj)];
                     if (i > 0)
                         sum -= a_x[c - 1] * xv[c - 1];
+                    else if (px)
+                        sum -= a_x[c + sj - 1] * seams.last[0][plane_index(0, i, j, k, ni, nj)];
                     if (j + 1 < nj)
                         sum -= a_y[c] * xv[c + sj];
+                    else if (py)
+                        sum -= a_y[c] * seams.first[1][plane_index(1, i, j, k, ni, nj)];
                     if (j > 0)
                         sum -= a_y[c - sj] * xv[c - sj];
+                    else if (py)
+                        sum -=
+                            a_y[c + sj * (nj - 1)] * seams.last[1][plane_index(1, i, j, k, ni, nj)];
                     if (k + 1 < nk)
                         sum -= a_z[c] * xv[c + sk];
+                    else if (pz)
+                        sum -= a_z[c] * seams.first[2][plane_index(2, i, j, k, ni, nj)];
                     if (k > 0)
                         sum -= a_z[c - sk] * xv[c - sk];
+                    else if (pz)
+                        sum -=
+                            a_z[c + sk * (nk - 1)] * seams.last[2][plane_index(2, i, j, k, ni, nj)];
                     xv[c] = sum / a_d[c];
                 }
             }
@@ -333,9 +420,9 @@ MultigridPreconditioner::MultigridPreconditioner(const PoissonMatrix& matrix,
             break;
         }
         Level& level = m_levels.back();
-        level.transfer[0] = make_axis_transfer(current.ni());
-        level.transfer[1] = make_axis_transfer(current.nj());
-        level.transfer[2] = make_axis_transfer(current.nk());
+        level.transfer[0] = make_axis_transfer(current.ni(), current.periodic[0]);
+        level.transfer[1] = make_axis_transfer(current.nj(), current.periodic[1]);
+        level.transfer[2] = make_axis_transfer(current.nk(), current.periodic[2]);
         Level coarse;
         build_coarse_matrix(current, coarse.matrix);
         m_levels.push_back(std::move(coarse));
@@ -365,15 +452,15 @@ void MultigridPreconditioner::cycle(std::size_t level, const std::vector<double>
     if (level + 1 == m_levels.size()) {
         // Palindromic order R (B R)^n keeps the coarsest solve a symmetric operator.
         for (int sweep = 0; sweep < m_options.coarsest_sweeps; ++sweep) {
-            smooth_colour(a, b, x, BLACK);
-            smooth_colour(a, b, x, RED);
+            smooth_colour(a, b, x, BLACK, data.seams);
+            smooth_colour(a, b, x, RED, data.seams);
         }
         return;
     }
-    smooth_colour(a, b, x, BLACK);
+    smooth_colour(a, b, x, BLACK, data.seams);
     for (int sweep = 1; sweep < m_options.smoothing_sweeps; ++sweep) {
-        smooth_colour(a, b, x, RED);
-        smooth_colour(a, b, x, BLACK);
+        smooth_colour(a, b, x, RED, data.seams);
+        smooth_colour(a, b, x, BLACK, data.seams);
     }
     a.residual(x, b, data.r);
     const PoissonMatrix& coarse = level_matrix(level + 1);
@@ -382,8 +469,8 @@ void MultigridPreconditioner::cycle(std::size_t level, const std::vector<double>
     cycle(level + 1, next.b, next.x);
     prolong_add(data.transfer, coarse, next.x, a, x);
     for (int sweep = 0; sweep < m_options.smoothing_sweeps; ++sweep) {
-        smooth_colour(a, b, x, BLACK);
-        smooth_colour(a, b, x, RED);
+        smooth_colour(a, b, x, BLACK, data.seams);
+        smooth_colour(a, b, x, RED, data.seams);
     }
 }
 

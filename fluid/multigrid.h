@@ -7,9 +7,11 @@
 /// face, the (½, 1, ½)-weighted average of the three fine faces between the two coarse centres;
 /// ½ · the sum over the lines), the Dirichlet (free-surface) part of the diagonal is summed and
 /// scaled by ½ the same way; transfers are cell-centred
-/// trilinear prolongation P and restriction Pᵀ; smoothing is red–black Gauss–Seidel, red→black
+/// trilinear prolongation P and restriction Pᵀ (wrapping around periodic axes, see
+/// PoissonMatrix::periodic); smoothing is red–black Gauss–Seidel, red→black
 /// before and black→red after the coarse correction so the cycle is a symmetric operator.
 
+#include <array>
 #include <vector>
 
 #include "fluid/pcg.h"
@@ -25,6 +27,15 @@ struct MultigridOptions {
 
     /// Throws std::invalid_argument naming the field when out of range.
     void validate() const;
+};
+
+/// x on the first and the last plane of each periodic axis of a level, taken before each half
+/// sweep of the smoother: neighbours across the seam are read from here, so where an odd cell
+/// count puts one colour on both sides of the seam the half sweep is still a Jacobi update of its
+/// colour (the cycle stays symmetric, and independent of the order and the threads).
+struct SeamPlanes {
+    std::array<std::vector<double>, 3> first;
+    std::array<std::vector<double>, 3> last;
 };
 
 /// One V-cycle from a zero initial guess, as a symmetric preconditioner. The hierarchy is built in
@@ -57,6 +68,8 @@ private:
         mutable std::vector<double> b;  ///< right-hand side on this level (coarse levels only)
         mutable std::vector<double> r;  ///< residual scratch
         AxisTransfer transfer[3];       ///< to the next coarser level
+        /// x on the seam planes of periodic axes during a half sweep (smoother scratch)
+        mutable SeamPlanes seams;
     };
     const PoissonMatrix& level_matrix(std::size_t level) const;
     /// One V-cycle from x = 0 on `level` for right-hand side b (x is overwritten).

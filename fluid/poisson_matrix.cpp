@@ -42,6 +42,9 @@ void PoissonMatrix::apply(const std::vector<double>& x, std::vector<double>& y) 
     const double* a_z = off_z.data();
     const double* xv = x.data();
     double* yv = y.data();
+    // Distance back to the first cell from the last along each axis (the periodic seam).
+    const std::size_t wrap_x = sj - 1, wrap_y = sj * (n_j - 1), wrap_z = sk * (n_k - 1);
+    const bool px = periodic[0], py = periodic[1], pz = periodic[2];
     tbb::parallel_for(tbb::blocked_range<int>(0, n_k), [&](const tbb::blocked_range<int>& range) {
         for (int k = range.begin(); k != range.end(); ++k) {
             for (int j = 0; j < n_j; ++j) {
@@ -55,21 +58,50 @@ void PoissonMatrix::apply(const std::vector<double>& x, std::vector<double>& y) 
                     double sum = a_d[c] * xv[c];
                     if (i + 1 < n_i)
                         sum += a_x[c] * xv[c + 1];
+                    else if (px)
+                        sum += a_x[c] * xv[c - wrap_x];
                     if (i > 0)
                         sum += a_x[c - 1] * xv[c - 1];
+                    else if (px)
+                        sum += a_x[c + wrap_x] * xv[c + wrap_x];
                     if (j + 1 < n_j)
                         sum += a_y[c] * xv[c + sj];
+                    else if (py)
+                        sum += a_y[c] * xv[c - wrap_y];
                     if (j > 0)
                         sum += a_y[c - sj] * xv[c - sj];
+                    else if (py)
+                        sum += a_y[c + wrap_y] * xv[c + wrap_y];
                     if (k + 1 < n_k)
                         sum += a_z[c] * xv[c + sk];
+                    else if (pz)
+                        sum += a_z[c] * xv[c - wrap_z];
                     if (k > 0)
                         sum += a_z[c - sk] * xv[c - sk];
+                    else if (pz)
+                        sum += a_z[c + wrap_z] * xv[c + wrap_z];
                     yv[c] = sum;
                 }
             }
         }
     });
+}
+
+PoissonMatrix PoissonMatrix::without_wrap() const {
+    PoissonMatrix copy = *this;
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!periodic[static_cast<std::size_t>(axis)])
+            continue;
+        Array3<double>& entries = copy.off(axis);
+        const int last = (axis == 0 ? ni() : (axis == 1 ? nj() : nk())) - 1;
+        for (int k = 0; k < nk(); ++k)
+            for (int j = 0; j < nj(); ++j)
+                for (int i = 0; i < ni(); ++i)
+                    if ((axis == 0 ? i : (axis == 1 ? j : k)) == last)
+                        entries(i, j, k) = 0.0;
+    }
+    copy.periodic = {false, false, false};
+    return copy;
 }
 
 void PoissonMatrix::residual(const std::vector<double>& x, const std::vector<double>& b,

@@ -6,6 +6,7 @@
 /// i + ni·(j + nj·k). A cell is an unknown ("active") iff its diagonal is > 0; inactive rows and
 /// columns are entirely zero and the kernels keep inactive entries of their outputs at zero.
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -14,15 +15,19 @@
 namespace meniscus::fluid {
 
 /// Symmetric 7-point matrix with one diagonal and three off-diagonal arrays (8 bytes each per
-/// cell). off_x(i, j, k) = A(cell(i,j,k), cell(i+1,j,k)) ≤ 0, likewise off_y and off_z; entries
-/// pointing outside the grid are 0.
+/// cell). off_x(i, j, k) = A(cell(i,j,k), cell(i+1,j,k)) ≤ 0, likewise off_y and off_z. Along a
+/// `periodic` axis the last cell's entry couples it to the first (off_x(ni−1, j, k) =
+/// A(cell(ni−1,j,k), cell(0,j,k)): the face across the periodic seam); along the other axes
+/// entries pointing outside the grid are 0.
 struct PoissonMatrix {
     Array3<double> diag;
     Array3<double> off_x;
     Array3<double> off_y;
     Array3<double> off_z;
+    /// Per axis: does the last cell's off-diagonal entry wrap around to the first cell?
+    std::array<bool, 3> periodic = {false, false, false};
 
-    /// Zero matrix on ni × nj × nk cells.
+    /// Zero matrix on ni × nj × nk cells (`periodic` is kept).
     void resize(int ni, int nj, int nk);
     int ni() const { return diag.ni(); }
     int nj() const { return diag.nj(); }
@@ -34,6 +39,17 @@ struct PoissonMatrix {
 
     /// y = A x (TBB-parallel over z-slabs). x and y have size(); y is resized if needed.
     void apply(const std::vector<double>& x, std::vector<double>& y) const;
+    /// The off-diagonal array of `axis` (0 → off_x, 1 → off_y, 2 → off_z).
+    Array3<double>& off(int axis) { return axis == 0 ? off_x : (axis == 1 ? off_y : off_z); }
+    const Array3<double>& off(int axis) const {
+        return axis == 0 ? off_x : (axis == 1 ? off_y : off_z);
+    }
+    /// True if some axis is periodic.
+    bool any_periodic() const { return periodic[0] || periodic[1] || periodic[2]; }
+    /// A copy without the couplings across periodic seams (those entries zeroed, no axis
+    /// periodic): the same diagonal, so it stays positive definite where A is semidefinite.
+    PoissonMatrix without_wrap() const;
+
     /// r = b − A x.
     void residual(const std::vector<double>& x, const std::vector<double>& b,
                   std::vector<double>& r) const;

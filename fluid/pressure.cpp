@@ -61,28 +61,32 @@ bool is_unknown(double phi, FluidMode mode) {
 }
 
 /// Calls visit(face index (i, j, k), lo cell (li, lj, lk)) for every face of component `axis`
-/// that lies strictly inside the box; the hi cell is (i, j, k).
+/// that lies strictly inside the box; the hi cell is (i, j, k). With a `periodic` axis the face
+/// on the min side is the seam between cell n−1 (lo) and cell 0 (hi), and is visited too (its
+/// copy on the max side is not); not where n = 1 (the cell would neighbour itself).
 template <class Visit>
-void for_each_interior_face(const MacGrid& grid, int axis, Visit&& visit) {
+void for_each_interior_face(const MacGrid& grid, int axis, bool periodic, Visit&& visit) {
     const Array3<double>& faces = grid.velocity(axis);
     const int n_axis = grid.cells(axis);
+    const bool seam = periodic && n_axis > 1;
     for (int k = 0; k < faces.nk(); ++k) {
         for (int j = 0; j < faces.nj(); ++j) {
             for (int i = 0; i < faces.ni(); ++i) {
                 const int along = axis == 0 ? i : (axis == 1 ? j : k);
-                if (along == 0 || along == n_axis) {
+                if ((along == 0 && !seam) || along == n_axis) {
                     continue;
                 }
-                visit(i, j, k, i - (axis == 0 ? 1 : 0), j - (axis == 1 ? 1 : 0),
-                      k - (axis == 2 ? 1 : 0));
+                const int back = along == 0 ? n_axis - 1 : -1;  // to the lo cell
+                visit(i, j, k, i + (axis == 0 ? back : 0), j + (axis == 1 ? back : 0),
+                      k + (axis == 2 ? back : 0));
             }
         }
     }
 }
 
-/// Calls visit(axis, face index (i, j, k), the cell inside it, its coupling) for every boundary face
-/// of an outflow side of the box whose cell is an unknown of the face's ambient phase — the phase
-/// of most of its cells: a Dirichlet face with p = the outflow's pressure on the face itself,
+/// Calls visit(axis, face index (i, j, k), the cell inside it, its coupling) for every boundary
+/// face of an outflow side of the box whose cell is an unknown of the face's ambient phase — the
+/// phase of most of its cells: a Dirichlet face with p = the outflow's pressure on the face itself,
 /// half a cell from the cell's centre (coefficient 2/ρ of the cell's phase). The faces of the
 /// cells of the other phase (a drop or a bubble on its way out) are left out: they keep the
 /// zero-gradient velocity they were given (a Neumann face, like a wall's), so what leaves does
@@ -131,14 +135,10 @@ void for_each_outflow_face(const MacGrid& grid, const InterfaceInput& interface,
                         coupling.beta = 1.0 / (OUTFLOW_FRACTION *
                                                face_density(theta, phases, FluidMode::two_phase));
                         coupling.boundary_pressure = boundary.pressure;
-                        visit(axis, face[0], face[1], face[2],
-                              phi.index(cell[0], cell[1], cell[2]), coupling);
+                        visit(axis, face[0], face[1], face[2], phi.index(cell[0], cell[1], cell[2]),
+                              coupling);
                     }
         }
-}
-
-Array3<double>& off_diagonal(PoissonMatrix& matrix, int axis) {
-    return axis == 0 ? matrix.off_x : (axis == 1 ? matrix.off_y : matrix.off_z);
 }
 
 }  // namespace
@@ -173,35 +173,38 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
     const Array3<double>& phi = interface.phi;
     bool has_dirichlet = false;
     for (int axis = 0; axis < 3; ++axis) {
-        Array3<double>& off = off_diagonal(a, axis);
+        a.periodic[static_cast<std::size_t>(axis)] = boundaries.periodic(axis);
+        Array3<double>& off = a.off(axis);
         const Array3<double>& kappa = interface.kappa(axis);
-        for_each_interior_face(grid, axis, [&](int i, int j, int k, int li, int lj, int lk) {
-            const std::size_t hi = phi.index(i, j, k);
-            const std::size_t lo = phi.index(li, lj, lk);
-            const FaceCoupling face = classify_face(phi[lo], phi[hi], kappa(i, j, k), phases, mode,
-                                                    options.min_liquid_fraction);
-            switch (face.kind) {
-                case FaceCoupling::Kind::none:
-                    break;
-                case FaceCoupling::Kind::coupled:
-                    a.diag[lo] += face.beta;
-                    a.diag[hi] += face.beta;
-                    off[lo] = -face.beta;
-                    b[lo] -= face.beta * face.jump;
-                    b[hi] += face.beta * face.jump;
-                    break;
-                case FaceCoupling::Kind::dirichlet_lo:
-                    a.diag[lo] += face.beta;
-                    b[lo] += face.beta * face.boundary_pressure;
-                    has_dirichlet = true;
-                    break;
-                case FaceCoupling::Kind::dirichlet_hi:
-                    a.diag[hi] += face.beta;
-                    b[hi] += face.beta * face.boundary_pressure;
-                    has_dirichlet = true;
-                    break;
-            }
-        });
+        for_each_interior_face(grid, axis, boundaries.periodic(axis),
+                               [&](int i, int j, int k, int li, int lj, int lk) {
+                                   const std::size_t hi = phi.index(i, j, k);
+                                   const std::size_t lo = phi.index(li, lj, lk);
+                                   const FaceCoupling face =
+                                       classify_face(phi[lo], phi[hi], kappa(i, j, k), phases, mode,
+                                                     options.min_liquid_fraction);
+                                   switch (face.kind) {
+                                       case FaceCoupling::Kind::none:
+                                           break;
+                                       case FaceCoupling::Kind::coupled:
+                                           a.diag[lo] += face.beta;
+                                           a.diag[hi] += face.beta;
+                                           off[lo] = -face.beta;
+                                           b[lo] -= face.beta * face.jump;
+                                           b[hi] += face.beta * face.jump;
+                                           break;
+                                       case FaceCoupling::Kind::dirichlet_lo:
+                                           a.diag[lo] += face.beta;
+                                           b[lo] += face.beta * face.boundary_pressure;
+                                           has_dirichlet = true;
+                                           break;
+                                       case FaceCoupling::Kind::dirichlet_hi:
+                                           a.diag[hi] += face.beta;
+                                           b[hi] += face.beta * face.boundary_pressure;
+                                           has_dirichlet = true;
+                                           break;
+                                   }
+                               });
     }
     for_each_outflow_face(grid, interface, phases, mode, boundaries,
                           [&](int, int, int, int, std::size_t c, const FaceCoupling& face) {
@@ -257,10 +260,9 @@ SolveResult PressureSystemSolver::solve(const std::vector<double>& rhs,
                                     std::to_string(a.size()) + " cells");
     std::vector<double> solution;
     const SolveResult result =
-        m_preconditioner ? solve_pcg(a, rhs, *m_preconditioner, m_options.iteration,
-                                     m_system.singular, solution)
-                         : solve_eigen_ic_cg(a, rhs, m_options.iteration, m_system.singular,
-                                             solution);
+        m_preconditioner
+            ? solve_pcg(a, rhs, *m_preconditioner, m_options.iteration, m_system.singular, solution)
+            : solve_eigen_ic_cg(a, rhs, m_options.iteration, m_system.singular, solution);
     pressure.resize(a.ni(), a.nj(), a.nk(), 0.0);
     pressure.storage() = std::move(solution);
     return result;
@@ -303,38 +305,45 @@ void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
     for (int axis = 0; axis < 3; ++axis) {
         Array3<double>& velocity = grid.velocity(axis);
         const Array3<double>& kappa = interface.kappa(axis);
-        for_each_interior_face(grid, axis, [&](int i, int j, int k, int li, int lj, int lk) {
-            const std::size_t hi = phi.index(i, j, k);
-            const std::size_t lo = phi.index(li, lj, lk);
-            const FaceCoupling face = classify_face(phi[lo], phi[hi], kappa(i, j, k), phases, mode,
-                                                    options.min_liquid_fraction);
-            double difference = 0.0;  // p(hi) − p(lo) as seen from the unknown side(s), Pa
-            switch (face.kind) {
-                case FaceCoupling::Kind::none:
-                    return;
-                case FaceCoupling::Kind::coupled:
-                    difference = pressure[hi] - pressure[lo] - face.jump;
-                    break;
-                case FaceCoupling::Kind::dirichlet_lo:
-                    difference = face.boundary_pressure - pressure[lo];
-                    break;
-                case FaceCoupling::Kind::dirichlet_hi:
-                    difference = pressure[hi] - face.boundary_pressure;
-                    break;
-            }
-            velocity(i, j, k) -= scale * face.beta * difference;
-        });
+        for_each_interior_face(
+            grid, axis, boundaries.periodic(axis),
+            [&](int i, int j, int k, int li, int lj, int lk) {
+                const std::size_t hi = phi.index(i, j, k);
+                const std::size_t lo = phi.index(li, lj, lk);
+                const FaceCoupling face = classify_face(phi[lo], phi[hi], kappa(i, j, k), phases,
+                                                        mode, options.min_liquid_fraction);
+                double difference = 0.0;  // p(hi) − p(lo) as seen from the unknown side(s), Pa
+                switch (face.kind) {
+                    case FaceCoupling::Kind::none:
+                        return;
+                    case FaceCoupling::Kind::coupled:
+                        difference = pressure[hi] - pressure[lo] - face.jump;
+                        break;
+                    case FaceCoupling::Kind::dirichlet_lo:
+                        difference = face.boundary_pressure - pressure[lo];
+                        break;
+                    case FaceCoupling::Kind::dirichlet_hi:
+                        difference = pressure[hi] - face.boundary_pressure;
+                        break;
+                }
+                velocity(i, j, k) -= scale * face.beta * difference;
+                if ((axis == 0 ? i : (axis == 1 ? j : k)) ==
+                    0) {  // a seam: its copy on the max side
+                    std::array<int, 3> copy = {i, j, k};
+                    copy[static_cast<std::size_t>(axis)] = grid.cells(axis);
+                    velocity(copy[0], copy[1], copy[2]) = velocity(i, j, k);
+                }
+            });
     }
-    for_each_outflow_face(grid, interface, phases, mode, boundaries,
-                          [&](int axis, int i, int j, int k, std::size_t c,
-                              const FaceCoupling& face) {
-                              // p(hi) − p(lo) across the face, the outside being the face's p.
-                              const double difference =
-                                  face.kind == FaceCoupling::Kind::dirichlet_lo
-                                      ? face.boundary_pressure - pressure[c]
-                                      : pressure[c] - face.boundary_pressure;
-                              grid.velocity(axis)(i, j, k) -= scale * face.beta * difference;
-                          });
+    for_each_outflow_face(
+        grid, interface, phases, mode, boundaries,
+        [&](int axis, int i, int j, int k, std::size_t c, const FaceCoupling& face) {
+            // p(hi) − p(lo) across the face, the outside being the face's p.
+            const double difference = face.kind == FaceCoupling::Kind::dirichlet_lo
+                                          ? face.boundary_pressure - pressure[c]
+                                          : pressure[c] - face.boundary_pressure;
+            grid.velocity(axis)(i, j, k) -= scale * face.beta * difference;
+        });
 }
 
 double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface, FluidMode mode) {
