@@ -69,8 +69,8 @@ double mesh_data_area(const tracker::MeshData& data) {
 /// The initial surface's geometry and connectivity (labels still the default: liquid inside).
 /// `preloaded`: the mesh file's contents when the caller has read them already.
 SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::string* report,
-                                                  double* nominal_xi,
-                                                  const tracker::MeshData* preloaded = nullptr) {
+                                           double* nominal_xi,
+                                           const tracker::MeshData* preloaded = nullptr) {
     if (scene.shape) {
         tracker::ImplicitMeshOptions options;
         options.edge_length = scene.surface.edge_length;
@@ -90,8 +90,8 @@ SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::string* repo
             throw InputError(scene.source_path + ": /surface/shape at " + edge_length_keys(scene) +
                              ": " + e.what());
         }
-        check_intersection_free(mesh, scene.source_path + ": /surface/shape meshed at " +
-                                          edge_length_keys(scene));
+        check_intersection_free(
+            mesh, scene.source_path + ": /surface/shape meshed at " + edge_length_keys(scene));
         if (report) {
             std::ostringstream s;
             s << "meshed shape: " << r.vertices << " vertices, " << r.triangles
@@ -148,12 +148,24 @@ void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::M
     }
 }
 
+/// Periodic faces: the fluid step handles them (inviscid), the surface mesh does not wrap around
+/// the box yet, so a scene cannot use them. Throws InputError naming the face.
+void check_no_periodic_faces(const Scene& scene) {
+    static const char* const faces[3] = {"x_min", "y_min", "z_min"};
+    for (int axis = 0; axis < 3; ++axis)
+        if (scene.fluid.boundaries.periodic(axis))
+            throw InputError(scene.source_path + ": /fluid/boundaries/" + faces[axis] +
+                             ": periodic faces are not available in scenes yet: the fluid step "
+                             "handles them (without viscosity), the surface mesh does not wrap "
+                             "around the box (issue 39); use free_slip walls");
+}
+
 /// Each inflow lets in the phase the surface puts at its region's centre, half a cell inside
 /// the box (a jet's or bubble's surface must reach through the face, or the box hold that phase
 /// around the face). Throws InputError naming the inflow's phase otherwise.
 void check_inflow_phases(const Scene& scene, const SurfaceMesh& mesh, const fluid::MacGrid& grid) {
-    static const char* const faces[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"},
-                                            {"z_min", "z_max"}};
+    static const char* const faces[3][2] = {
+        {"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
     const Vec3 lo = grid.origin();
     const Vec3 hi = lo + grid.dx() * Vec3(grid.nx(), grid.ny(), grid.nz());
     for (int axis = 0; axis < 3; ++axis)
@@ -165,8 +177,7 @@ void check_inflow_phases(const Scene& scene, const SurfaceMesh& mesh, const flui
                                                                           : Vec3(0.5 * (lo + hi));
             centre[axis] = side == 0 ? lo[axis] + 0.5 * grid.dx() : hi[axis] - 0.5 * grid.dx();
             const int liquid = scene.coupling.simulation.rasterize.liquid_region;
-            const bool liquid_there =
-                coupling::region_at(mesh, centre, 0) == liquid;
+            const bool liquid_there = coupling::region_at(mesh, centre, 0) == liquid;
             const bool liquid_in = face.inflow.phase == fluid::InflowPhase::liquid;
             if (liquid_there == liquid_in)
                 continue;
@@ -238,6 +249,7 @@ SurfaceMesh checked_initial_surface(const Scene& scene, const ResourceLimits& li
 
 coupling::Simulation make_fluid_simulation(const Scene& scene, SurfaceMesh initial,
                                            double nominal_xi) {
+    check_no_periodic_faces(scene);
     const double dx = scene.domain.size.x() / scene.domain.cells;
     const auto cells_along = [&](double size, const char* key) {
         const double n = std::round(size / dx);
@@ -250,9 +262,9 @@ coupling::Simulation make_fluid_simulation(const Scene& scene, SurfaceMesh initi
     fluid::FluidOptions options = scene.fluid;
     options.pressure.iteration.cancel = scene.cancel;
     options.viscosity.iteration.cancel = scene.cancel;
-    fluid::FluidSolver solver(scene.domain.cells, cells_along(scene.domain.size.y(), "/domain/size/1"),
-                              cells_along(scene.domain.size.z(), "/domain/size/2"), dx,
-                              scene.domain.min, options);
+    fluid::FluidSolver solver(
+        scene.domain.cells, cells_along(scene.domain.size.y(), "/domain/size/1"),
+        cells_along(scene.domain.size.z(), "/domain/size/2"), dx, scene.domain.min, options);
     apply_initial_velocity(scene.initial_velocity, solver.grid(), scene.cancel);
     // The velocity regions may have reached the box's faces.
     fluid::apply_boundary_velocity(solver.grid(), options.boundaries, solver.time());

@@ -59,6 +59,11 @@ Simulation::Simulation(tracker::SurfaceTracker tracker, fluid::FluidSolver fluid
       m_fluid(std::move(fluid)),
       m_options(options) {
     m_options.validate();
+    const fluid::Periodicity& periodic = m_fluid.grid().periodic();
+    if (periodic[0] || periodic[1] || periodic[2])
+        throw std::invalid_argument(
+            "Simulation: periodic faces are not available with a surface mesh yet (the mesh does "
+            "not wrap around the box; issue 39)");
     if (m_options.volume_correction)
         m_volumes = std::make_unique<VolumeTracker>(m_tracker->mesh());
     m_vertex_velocities.assign(static_cast<size_t>(m_tracker->mesh().num_vertices()),
@@ -128,9 +133,9 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     if (boundaries.inflow())
         held = held_vertices(mesh, grid, boundaries);
     report.improve = m_tracker->improve(held.empty() ? nullptr : &held);
-    report.open_boundaries = apply_open_boundaries(
-        mesh, grid, boundaries, m_fluid.time(), report.dt, m_options.rasterize.liquid_region,
-        m_options.open_boundaries, m_volumes.get());
+    report.open_boundaries = apply_open_boundaries(mesh, grid, boundaries, m_fluid.time(),
+                                                   report.dt, m_options.rasterize.liquid_region,
+                                                   m_options.open_boundaries, m_volumes.get());
     m_boundary_volumes += report.open_boundaries.volumes;
     report.topology = m_tracker->change_topology();  // compacts
     clock.lap_into(timings.tracker);
@@ -162,9 +167,9 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     }
     report.integrate = m_tracker->integrate(velocities, report.dt, pinned);
     clock.lap_into(timings.tracker);
-    for (const PhaseSeconds* phase : {&timings.rasterize, &timings.curvature, &timings.fluid,
-                                      &timings.interpolate, &timings.volume_correction,
-                                      &timings.tracker})
+    for (const PhaseSeconds* phase :
+         {&timings.rasterize, &timings.curvature, &timings.fluid, &timings.interpolate,
+          &timings.volume_correction, &timings.tracker})
         timings.total += *phase;
     m_time += report.integrate.time_advanced;
     return report;
@@ -186,8 +191,7 @@ void Simulation::add_subgrid_tension(std::vector<tracker::Vec3>& velocities, dou
     // Only vertices inside the fluid box (see subgrid_tension_velocities()).
     const fluid::MacGrid& grid = m_fluid.grid();
     const tracker::Vec3 lo = grid.origin();
-    const tracker::Vec3 hi =
-        lo + grid.dx() * tracker::Vec3(grid.nx(), grid.ny(), grid.nz());
+    const tracker::Vec3 hi = lo + grid.dx() * tracker::Vec3(grid.nx(), grid.ny(), grid.nz());
     std::vector<char> inside(static_cast<size_t>(mesh.num_vertices()), 0);
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
         if (!mesh.vertex_alive(vi))
@@ -196,9 +200,8 @@ void Simulation::add_subgrid_tension(std::vector<tracker::Vec3>& velocities, dou
         inside[static_cast<size_t>(vi)] =
             (x.array() >= lo.array()).all() && (x.array() <= hi.array()).all() ? 1 : 0;
     }
-    const std::vector<tracker::Vec3> subgrid =
-        subgrid_tension_velocities(mesh, diffusivity, options.subgrid_resolved_passes,
-                                   options.subgrid_filter_order, inside);
+    const std::vector<tracker::Vec3> subgrid = subgrid_tension_velocities(
+        mesh, diffusivity, options.subgrid_resolved_passes, options.subgrid_filter_order, inside);
     const double max_speed = MAX_SUBGRID_STEP_EDGES * h / dt;
     for (size_t v = 0; v < velocities.size(); ++v) {
         const double speed = subgrid[v].norm();

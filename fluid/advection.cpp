@@ -15,26 +15,55 @@ constexpr double HALF = 0.5;
 
 /// Velocity in cell units per second (m/s ÷ dx) at a point given in cell units.
 Eigen::Vector3d grid_velocity(const std::array<const Array3<double>*, 3>& velocity,
-                              const Eigen::Vector3d& g, double inverse_dx) {
+                              const Eigen::Vector3d& g, double inverse_dx,
+                              const Periodicity& periodic) {
     return inverse_dx *
-           Eigen::Vector3d(interpolate_trilinear(*velocity[0], FieldLocation::x_face, g),
-                           interpolate_trilinear(*velocity[1], FieldLocation::y_face, g),
-                           interpolate_trilinear(*velocity[2], FieldLocation::z_face, g));
+           Eigen::Vector3d(interpolate_trilinear(*velocity[0], FieldLocation::x_face, g, periodic),
+                           interpolate_trilinear(*velocity[1], FieldLocation::y_face, g, periodic),
+                           interpolate_trilinear(*velocity[2], FieldLocation::z_face, g, periodic));
 }
 
-/// Is sample (i, j, k) of a field at `location` on a wall-normal face (kept fixed)?
-bool is_fixed_sample(FieldLocation location, const Array3<double>& field, int i, int j, int k) {
+/// The axis whose faces hold a field at `location` (−1 for cell centres).
+int face_axis(FieldLocation location) {
     switch (location) {
         case FieldLocation::x_face:
-            return i == 0 || i == field.ni() - 1;
+            return 0;
         case FieldLocation::y_face:
-            return j == 0 || j == field.nj() - 1;
+            return 1;
         case FieldLocation::z_face:
-            return k == 0 || k == field.nk() - 1;
+            return 2;
         case FieldLocation::cell_centre:
-            return false;
+            return -1;
     }
-    return false;
+    return -1;
+}
+
+/// Is sample (i, j, k) of a field at `location` on a wall-normal face (kept fixed)? Along a
+/// periodic axis the face at 0 is advected like an interior one and the one at n is its copy
+/// (also kept during the pass, set afterwards by copy_seam()).
+bool is_fixed_sample(FieldLocation location, const Array3<double>& field, int i, int j, int k,
+                     const Periodicity& periodic) {
+    const int axis = face_axis(location);
+    if (axis < 0)
+        return false;
+    const int along = axis == 0 ? i : (axis == 1 ? j : k);
+    const int last = (axis == 0 ? field.ni() : (axis == 1 ? field.nj() : field.nk())) - 1;
+    return (along == 0 && !periodic[static_cast<std::size_t>(axis)]) || along == last;
+}
+
+/// Along a periodic axis, the face samples at n of a face field of that axis repeat those at 0.
+void copy_seam(FieldLocation location, const Periodicity& periodic, Array3<double>& field) {
+    const int axis = face_axis(location);
+    if (axis < 0 || !periodic[static_cast<std::size_t>(axis)])
+        return;
+    const int last = (axis == 0 ? field.ni() : (axis == 1 ? field.nj() : field.nk())) - 1;
+    for (int k = 0; k < (axis == 2 ? 1 : field.nk()); ++k)
+        for (int j = 0; j < (axis == 1 ? 1 : field.nj()); ++j)
+            for (int i = 0; i < (axis == 0 ? 1 : field.ni()); ++i) {
+                std::array<int, 3> copy = {i, j, k};
+                copy[static_cast<std::size_t>(axis)] = last;
+                field(copy[0], copy[1], copy[2]) = field(i, j, k);
+            }
 }
 
 /// The inflow faces across which a component's samples are tangential: for each, the axis, the
@@ -81,14 +110,14 @@ void apply_tangential_inflows(const std::vector<TangentialInflow>& faces, const 
 void semi_lagrangian(const std::array<const Array3<double>*, 3>& velocity, double inverse_dx,
                      double dt, FieldLocation location, const Array3<double>& in,
                      Array3<double>& out, Array3<double>* lower, Array3<double>* upper,
-                     const std::vector<TangentialInflow>& inflows) {
+                     const std::vector<TangentialInflow>& inflows, const Periodicity& periodic) {
     const Eigen::Vector3d offset = field_offset(location);
     tbb::parallel_for(tbb::blocked_range<int>(0, in.nk()), [&](const tbb::blocked_range<int>& r) {
         for (int k = r.begin(); k != r.end(); ++k) {
             for (int j = 0; j < in.nj(); ++j) {
                 for (int i = 0; i < in.ni(); ++i) {
                     const std::size_t c = in.index(i, j, k);
-                    if (is_fixed_sample(location, in, i, j, k)) {
+                    if (is_fixed_sample(location, in, i, j, k, periodic)) {
                         out[c] = in[c];
                         if (lower != nullptr) {
                             (*lower)[c] = in[c];
@@ -98,11 +127,12 @@ void semi_lagrangian(const std::array<const Array3<double>*, 3>& velocity, doubl
                     }
                     const Eigen::Vector3d start = Eigen::Vector3d(i, j, k) + offset;
                     const Eigen::Vector3d mid =
-                        start - HALF * dt * grid_velocity(velocity, start, inverse_dx);
+                        start - HALF * dt * grid_velocity(velocity, start, inverse_dx, periodic);
                     const Eigen::Vector3d departure =
-                        start - dt * grid_velocity(velocity, mid, inverse_dx);
+                        start - dt * grid_velocity(velocity, mid, inverse_dx, periodic);
                     if (lower != nullptr || !inflows.empty()) {
-                        TrilinearSample sample = sample_trilinear(in, location, departure);
+                        TrilinearSample sample =
+                            sample_trilinear(in, location, departure, periodic);
                         apply_tangential_inflows(inflows, departure, sample);
                         out[c] = sample.value;
                         if (lower != nullptr) {
@@ -110,7 +140,7 @@ void semi_lagrangian(const std::array<const Array3<double>*, 3>& velocity, doubl
                             (*upper)[c] = sample.max;
                         }
                     } else {
-                        out[c] = interpolate_trilinear(in, location, departure);
+                        out[c] = interpolate_trilinear(in, location, departure, periodic);
                     }
                 }
             }
@@ -134,17 +164,20 @@ void advect_field(const MacGrid& grid, double dt, FieldLocation location,
     const std::vector<TangentialInflow> inflows = tangential_inflows(grid, location, boundaries);
     const std::array<const Array3<double>*, 3> velocity = {&grid.u(), &grid.v(), &grid.w()};
     const double inverse_dx = 1.0 / grid.dx();
+    const Periodicity& periodic = grid.periodic();
     const int ni = field.ni(), nj = field.nj(), nk = field.nk();
     Array3<double> forward(ni, nj, nk);
     Array3<double> lower(ni, nj, nk), upper(ni, nj, nk);
-    semi_lagrangian(velocity, inverse_dx, dt, location, field, forward, &lower, &upper, inflows);
+    semi_lagrangian(velocity, inverse_dx, dt, location, field, forward, &lower, &upper, inflows,
+                    periodic);
     if (options.scheme == AdvectionScheme::semi_lagrangian) {
         field = std::move(forward);
+        copy_seam(location, periodic, field);
         return;
     }
     Array3<double> backward(ni, nj, nk);
     semi_lagrangian(velocity, inverse_dx, -dt, location, forward, backward, nullptr, nullptr,
-                    inflows);
+                    inflows, periodic);
     Array3<double> corrected(ni, nj, nk);
     if (options.scheme == AdvectionScheme::bfecc) {
         // Advect φ0 + (φ0 − φ̂0)/2 forward again.
@@ -153,7 +186,7 @@ void advect_field(const MacGrid& grid, double dt, FieldLocation location,
             compensated[c] = field[c] + HALF * (field[c] - backward[c]);
         }
         semi_lagrangian(velocity, inverse_dx, dt, location, compensated, corrected, nullptr,
-                        nullptr, inflows);
+                        nullptr, inflows, periodic);
     } else {
         // MacCormack: φ1 + (φ0 − φ̂0)/2.
         for (std::size_t c = 0; c < field.size(); ++c) {
@@ -164,6 +197,7 @@ void advect_field(const MacGrid& grid, double dt, FieldLocation location,
         const double value = corrected[c];
         field[c] = (value < lower[c] || value > upper[c]) ? forward[c] : value;
     }
+    copy_seam(location, periodic, field);
 }
 
 void advect_velocity(MacGrid& grid, double dt, const AdvectionOptions& options,

@@ -7,6 +7,8 @@
 /// box are sampled with constant extrapolation of the nearest samples, except for the velocity
 /// components tangential to an inflow face (boundary.h): the inflow brings no tangential
 /// velocity, so they fall linearly to 0 from the first sample to the face and are 0 beyond it.
+/// Along the grid's periodic axes (MacGrid::periodic()) the back-traces and samples wrap around
+/// the box; the face at n of a face field along such an axis is set to the one at 0.
 /// Every scheme reproduces constant fields exactly and linear fields exactly wherever the departure
 /// points stay in the box.
 

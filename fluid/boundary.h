@@ -14,9 +14,10 @@
 ///   The grid face on the min side is the unknown and the one on the max side its copy
 ///   (apply_boundary_velocity() keeps them equal); cell n−1 and cell 0 are neighbours across it.
 ///   Handled so far by the pressure projection (pressure.h; PoissonMatrix::periodic and its
-///   MIC(0), multigrid and Eigen solvers), gravity and apply_boundary_velocity(); advection,
-///   viscosity, extrapolation and the interface do not wrap yet, so FluidOptions::validate()
-///   refuses periodic faces (issue 39).
+///   MIC(0), multigrid and Eigen solvers), gravity, advection, sampling and extrapolation (the
+///   grid's MacGrid::periodic()); the viscous solve does not wrap yet, so FluidOptions::validate()
+///   refuses periodic faces with viscosity, and the surface mesh does not, so a coupled
+///   Simulation refuses them (issue 39).
 /// On the MAC grid the normal velocity of a face lives on the boundary faces of the grid (see
 /// mac_grid.h); walls and inflows set it, outflows leave it to the pressure projection.
 

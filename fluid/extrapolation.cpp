@@ -20,7 +20,11 @@ void extrapolate_velocity(MacGrid& grid, const InterfaceInput& interface, int la
     }
     interface.validate(grid);
     const Array3<double>& phi = interface.phi;
+    const Periodicity& periodic = grid.periodic();
+    const std::array<int, 3> cells = {grid.nx(), grid.ny(), grid.nz()};
     for (int a = 0; a < 3; ++a) {
+        const bool seam =
+            periodic[static_cast<std::size_t>(a)] && cells[static_cast<std::size_t>(a)] > 1;
         Array3<double>& faces = grid.velocity(a);
         const int n_axis = grid.cells(a);
         Array3<std::uint8_t> state(faces.ni(), faces.nj(), faces.nk(), UNKNOWN);
@@ -29,11 +33,11 @@ void extrapolate_velocity(MacGrid& grid, const InterfaceInput& interface, int la
                 for (int i = 0; i < faces.ni(); ++i) {
                     std::array<int, 3> lo = {i, j, k};
                     const int along = lo[a];
-                    if (along == 0 || along == n_axis) {
-                        state(i, j, k) = WALL;
+                    if ((along == 0 && !seam) || along == n_axis) {
+                        state(i, j, k) = WALL;  // on a periodic axis the face at n: a copy
                         continue;
                     }
-                    --lo[a];
+                    lo[a] = along == 0 ? n_axis - 1 : along - 1;  // across the seam at 0
                     if (is_liquid(phi(i, j, k)) || is_liquid(phi(lo[0], lo[1], lo[2]))) {
                         state(i, j, k) = KNOWN;
                     }
@@ -58,7 +62,10 @@ void extrapolate_velocity(MacGrid& grid, const InterfaceInput& interface, int la
                                                                                {i, j + 1, k},
                                                                                {i, j, k - 1},
                                                                                {i, j, k + 1}}};
-                        for (const auto& nb : neighbours) {
+                        for (std::array<int, 3> nb : neighbours) {
+                            for (std::size_t b = 0; b < 3; ++b)
+                                if (periodic[b])  // cells[b] distinct samples along b
+                                    nb[b] = (nb[b] + cells[b]) % cells[b];
                             if (state.contains(nb[0], nb[1], nb[2]) &&
                                 state(nb[0], nb[1], nb[2]) == KNOWN) {
                                 sum += faces(nb[0], nb[1], nb[2]);
@@ -85,6 +92,14 @@ void extrapolate_velocity(MacGrid& grid, const InterfaceInput& interface, int la
                 faces[f] = 0.0;
             }
         }
+        if (seam)  // the faces at n repeat those at 0
+            for (int k = 0; k < (a == 2 ? 1 : faces.nk()); ++k)
+                for (int j = 0; j < (a == 1 ? 1 : faces.nj()); ++j)
+                    for (int i = 0; i < (a == 0 ? 1 : faces.ni()); ++i) {
+                        std::array<int, 3> copy = {i, j, k};
+                        copy[static_cast<std::size_t>(a)] = n_axis;
+                        faces(copy[0], copy[1], copy[2]) = faces(i, j, k);
+                    }
     }
 }
 

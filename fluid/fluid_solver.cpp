@@ -59,14 +59,17 @@ void FluidOptions::validate() const {
     } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(std::string("boundaries/") + e.what());
     }
+    const bool viscous =
+        viscosity.enabled &&
+        (phases.mu_liquid > 0.0 || (mode == FluidMode::two_phase && phases.mu_gas > 0.0));
     for (const char* axis : {"x", "y", "z"}) {
         const int a = axis[0] - 'x';
-        if (boundaries.periodic(a))
+        if (boundaries.periodic(a) && viscous)
             throw std::invalid_argument(
                 std::string("boundaries/") + axis +
-                "_min: periodic faces are not available in the fluid step yet: the pressure "
-                "projection handles them, advection, viscosity, extrapolation and the surface "
-                "mesh do not (issue 39); use free_slip walls");
+                "_min: periodic faces are not available with viscosity yet: the pressure "
+                "projection, advection and extrapolation wrap around the box, the viscous solve "
+                "does not (issue 39); set the viscosities to 0 or use free_slip walls");
     }
     advection.validate();
     viscosity.validate();
@@ -81,6 +84,8 @@ void FluidOptions::validate() const {
 FluidSolver::FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3d& origin,
                          const FluidOptions& options)
     : m_options(validated(options)), m_grid(nx, ny, nz, dx, origin), m_pressure(nx, ny, nz, 0.0) {
+    const BoundaryOptions& b = m_options.boundaries;
+    m_grid.set_periodic({b.periodic(0), b.periodic(1), b.periodic(2)});
     apply_boundary_velocity(m_grid, m_options.boundaries);
 }
 
@@ -89,6 +94,11 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
         throw std::invalid_argument("FluidSolver::step: dt must be positive (s)");
     }
     interface.validate(m_grid);
+    const Periodicity& periodic = m_grid.periodic();
+    if ((periodic[0] || periodic[1] || periodic[2]) && interface.surface_viscosity)
+        throw std::invalid_argument(
+            "FluidSolver::step: semi-implicit surface tension (a viscous solve) is not available "
+            "with periodic faces yet");
     StepResult result;
     PhaseClock step_clock;
     PhaseClock clock;
@@ -167,6 +177,7 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
         // No previous pressure: start from the one that balances the body force and the jump
         // (hydrostatic plus Laplace), so that rest is exact from the first step.
         MacGrid body(m_grid.nx(), m_grid.ny(), m_grid.nz(), m_grid.dx(), m_grid.origin());
+        body.set_periodic(m_grid.periodic());
         apply_gravity(body, m_options.gravity, dt, boundaries);
         add_solve(result.pressure, project(body, interface, phases, mode, dt, m_options.pressure,
                                            m_pressure, boundaries)
@@ -243,6 +254,7 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
             direction.storage() = z;
             rz = dot(r, z);
             impulse = MacGrid(m_grid.nx(), m_grid.ny(), m_grid.nz(), dx, m_grid.origin());
+            impulse.set_periodic(m_grid.periodic());
         }
         clock.lap_into(result.timings.pressure_solve);
         for (int iteration = 0; iteration < max_iterations && !result.converged_passes;

@@ -55,17 +55,52 @@ FieldLocation face_location(int axis) {
 
 namespace {
 
+/// The face location of axis a (face_location() without its range check).
+FieldLocation face_location_of(int a) {
+    return a == 0 ? FieldLocation::x_face
+                  : (a == 1 ? FieldLocation::y_face : FieldLocation::z_face);
+}
+
 /// The 8 samples around a point and its fractional position between them.
 struct Stencil {
     double c[8];  ///< (x, y, z) corners in the order 000, 100, 010, 110, 001, 101, 011, 111
     double fx, fy, fz;
 };
 
+/// Wraps a lattice coordinate onto a periodic lattice of `period` samples and splits it into the
+/// two sample indices around it and the fraction between them.
+void split_periodic(double s, int period, int& first, int& second, double& fraction) {
+    const double base = std::floor(s);
+    fraction = s - base;
+    first = static_cast<int>(base - period * std::floor(base / period));
+    second = first + 1 == period ? 0 : first + 1;
+}
+
 Stencil gather_stencil(const Array3<double>& field, FieldLocation location,
-                       const Eigen::Vector3d& grid_position) {
+                       const Eigen::Vector3d& grid_position, const Periodicity& periodic) {
     const Eigen::Vector3d s = grid_position - field_offset(location);
-    int i0, j0, k0;
     Stencil st;
+    if (periodic[0] || periodic[1] || periodic[2]) {
+        const std::array<int, 3> n = {field.ni(), field.nj(), field.nk()};
+        std::array<int, 3> lo{}, hi{};
+        double* fraction[3] = {&st.fx, &st.fy, &st.fz};
+        for (int a = 0; a < 3; ++a) {
+            const auto ax = static_cast<std::size_t>(a);
+            if (periodic[ax]) {
+                // A face field along its own axis holds the seam twice (0 and n).
+                const int period = location == face_location_of(a) ? n[ax] - 1 : n[ax];
+                split_periodic(s[a], period, lo[ax], hi[ax], *fraction[a]);
+            } else {
+                split_coordinate(s[a], n[ax], lo[ax], *fraction[a]);
+                hi[ax] = n[ax] > 1 ? lo[ax] + 1 : lo[ax];
+            }
+        }
+        for (int corner = 0; corner < 8; ++corner)
+            st.c[corner] = field((corner & 1) ? hi[0] : lo[0], (corner & 2) ? hi[1] : lo[1],
+                                 (corner & 4) ? hi[2] : lo[2]);
+        return st;
+    }
+    int i0, j0, k0;
     split_coordinate(s.x(), field.ni(), i0, st.fx);
     split_coordinate(s.y(), field.nj(), j0, st.fy);
     split_coordinate(s.z(), field.nk(), k0, st.fz);
@@ -98,13 +133,14 @@ double blend(const Stencil& st) {
 }  // namespace
 
 double interpolate_trilinear(const Array3<double>& field, FieldLocation location,
-                             const Eigen::Vector3d& grid_position) {
-    return blend(gather_stencil(field, location, grid_position));
+                             const Eigen::Vector3d& grid_position, const Periodicity& periodic) {
+    return blend(gather_stencil(field, location, grid_position, periodic));
 }
 
 TrilinearSample sample_trilinear(const Array3<double>& field, FieldLocation location,
-                                 const Eigen::Vector3d& grid_position) {
-    const Stencil st = gather_stencil(field, location, grid_position);
+                                 const Eigen::Vector3d& grid_position,
+                                 const Periodicity& periodic) {
+    const Stencil st = gather_stencil(field, location, grid_position, periodic);
     TrilinearSample sample;
     sample.value = blend(st);
     sample.min = *std::min_element(st.c, st.c + 8);
@@ -137,14 +173,14 @@ Eigen::Vector3d MacGrid::face_centre(int axis, int i, int j, int k) const {
 }
 
 double MacGrid::sample_component(int axis, const Eigen::Vector3d& x) const {
-    return interpolate_trilinear(m_velocity[axis], face_location(axis), to_grid(x));
+    return interpolate_trilinear(m_velocity[axis], face_location(axis), to_grid(x), m_periodic);
 }
 
 Eigen::Vector3d MacGrid::sample_velocity(const Eigen::Vector3d& x) const {
     const Eigen::Vector3d g = to_grid(x);
-    return {interpolate_trilinear(m_velocity[0], FieldLocation::x_face, g),
-            interpolate_trilinear(m_velocity[1], FieldLocation::y_face, g),
-            interpolate_trilinear(m_velocity[2], FieldLocation::z_face, g)};
+    return {interpolate_trilinear(m_velocity[0], FieldLocation::x_face, g, m_periodic),
+            interpolate_trilinear(m_velocity[1], FieldLocation::y_face, g, m_periodic),
+            interpolate_trilinear(m_velocity[2], FieldLocation::z_face, g, m_periodic)};
 }
 
 double MacGrid::divergence(int i, int j, int k) const {

@@ -13,6 +13,9 @@
 ///   the normal velocity of the box face (boundary.h: zero on walls, the inflow's, or the
 ///   projection's on an outflow).
 /// - Axes are numbered 0 = x, 1 = y, 2 = z; sides 0 = min wall, 1 = max wall.
+/// - Along a periodic axis (MacGrid::periodic(), boundary.h) the box repeats: cell n−1 neighbours
+///   cell 0, the face samples at 0 and n are the same face (the one at n a copy), and samples
+///   wrap around instead of being clamped.
 
 #include <array>
 
@@ -21,6 +24,9 @@
 #include "fluid/array3.h"
 
 namespace meniscus::fluid {
+
+/// Per axis: does the box repeat along it (see the file comment)?
+using Periodicity = std::array<bool, 3>;
 
 /// Where the samples of a grid field live (see the file comment).
 enum class FieldLocation { x_face, y_face, z_face, cell_centre };
@@ -41,13 +47,17 @@ struct TrilinearSample {
 
 /// Trilinear interpolation of `field` (stored at `location`) at `grid_position`, a point in cell
 /// units relative to the grid origin ((x − origin)/dx). Points outside the sample lattice are
-/// clamped onto it (constant extrapolation). Exact for fields linear in each coordinate.
+/// clamped onto it (constant extrapolation), except along the `periodic` axes, where the lattice
+/// repeats with the period of the box (its last face sample, a copy of the first, is not read).
+/// Exact for fields linear in each coordinate.
 TrilinearSample sample_trilinear(const Array3<double>& field, FieldLocation location,
-                                 const Eigen::Vector3d& grid_position);
+                                 const Eigen::Vector3d& grid_position,
+                                 const Periodicity& periodic = {});
 
 /// The value of sample_trilinear() alone (cheaper: no stencil bounds).
 double interpolate_trilinear(const Array3<double>& field, FieldLocation location,
-                             const Eigen::Vector3d& grid_position);
+                             const Eigen::Vector3d& grid_position,
+                             const Periodicity& periodic = {});
 
 /// Staggered MAC grid holding the face velocities (m/s). See the file comment for the layout.
 class MacGrid {
@@ -85,6 +95,11 @@ public:
     Eigen::Vector3d cell_centre(int i, int j, int k) const;
     /// Centre of face (i, j, k) of velocity component `axis`, in metres.
     Eigen::Vector3d face_centre(int axis, int i, int j, int k) const;
+    /// The axes along which the box repeats (default none); set from the boundaries by the
+    /// solver. Sampling wraps along them.
+    const Periodicity& periodic() const { return m_periodic; }
+    void set_periodic(const Periodicity& periodic) { m_periodic = periodic; }
+
     /// (x − origin)/dx: a position in cell units.
     Eigen::Vector3d to_grid(const Eigen::Vector3d& x) const { return (x - m_origin) / m_dx; }
 
@@ -106,6 +121,7 @@ private:
     int m_nz;
     double m_dx;
     Eigen::Vector3d m_origin;
+    Periodicity m_periodic = {false, false, false};
     std::array<Array3<double>, 3> m_velocity;
 };
 
