@@ -148,7 +148,7 @@ void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::M
     }
 }
 
-/// Periodic faces: the fluid step handles them (inviscid), the surface mesh does not wrap around
+/// Periodic faces: the fluid step handles them, the surface mesh does not wrap around
 /// the box yet, so a scene cannot use them. Throws InputError naming the face.
 void check_no_periodic_faces(const Scene& scene) {
     static const char* const faces[3] = {"x_min", "y_min", "z_min"};
@@ -156,7 +156,7 @@ void check_no_periodic_faces(const Scene& scene) {
         if (scene.fluid.boundaries.periodic(axis))
             throw InputError(scene.source_path + ": /fluid/boundaries/" + faces[axis] +
                              ": periodic faces are not available in scenes yet: the fluid step "
-                             "handles them (without viscosity), the surface mesh does not wrap "
+                             "handles them, the surface mesh does not wrap "
                              "around the box (issue 39); use free_slip walls");
 }
 

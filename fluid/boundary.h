@@ -13,10 +13,9 @@
 /// - `periodic`, on both faces of an axis: what leaves through one face enters through the other.
 ///   The grid face on the min side is the unknown and the one on the max side its copy
 ///   (apply_boundary_velocity() keeps them equal); cell n−1 and cell 0 are neighbours across it.
-///   Handled so far by the pressure projection (pressure.h; PoissonMatrix::periodic and its
-///   MIC(0), multigrid and Eigen solvers), gravity, advection, sampling and extrapolation (the
-///   grid's MacGrid::periodic()); the viscous solve does not wrap yet, so FluidOptions::validate()
-///   refuses periodic faces with viscosity, and the surface mesh does not, so a coupled
+///   Every grid operator wraps around them: the pressure projection (PoissonMatrix::periodic and
+///   its MIC(0), multigrid and Eigen solvers), viscosity, gravity, advection, sampling and
+///   extrapolation (MacGrid::periodic()). The surface mesh does not wrap yet, so a coupled
 ///   Simulation refuses them (issue 39).
 /// On the MAC grid the normal velocity of a face lives on the boundary faces of the grid (see
 /// mac_grid.h); walls and inflows set it, outflows leave it to the pressure projection.

@@ -59,18 +59,6 @@ void FluidOptions::validate() const {
     } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(std::string("boundaries/") + e.what());
     }
-    const bool viscous =
-        viscosity.enabled &&
-        (phases.mu_liquid > 0.0 || (mode == FluidMode::two_phase && phases.mu_gas > 0.0));
-    for (const char* axis : {"x", "y", "z"}) {
-        const int a = axis[0] - 'x';
-        if (boundaries.periodic(a) && viscous)
-            throw std::invalid_argument(
-                std::string("boundaries/") + axis +
-                "_min: periodic faces are not available with viscosity yet: the pressure "
-                "projection, advection and extrapolation wrap around the box, the viscous solve "
-                "does not (issue 39); set the viscosities to 0 or use free_slip walls");
-    }
     advection.validate();
     viscosity.validate();
     pressure.validate();

@@ -45,9 +45,11 @@ public:
         m_dx = grid.dx();
         m_dt = dt;
         m_surface = surface;
-        for (int a = 0; a < 3; ++a)
+        for (int a = 0; a < 3; ++a) {
             for (int side = 0; side < 2; ++side)
                 m_open[a][side] = walls.at(a, side) == BoundaryType::outflow;
+            m_periodic[static_cast<std::size_t>(a)] = walls.periodic(a);
+        }
         // The surface term's energy ½ Δt μ_s (S u)ᵀ L (S u), per cell volume as the rest.
         m_surface_scale = surface ? dt * surface->viscosity / (m_dx * m_dx * m_dx) : 0.0;
         std::size_t offset = 0;
@@ -64,8 +66,8 @@ public:
         }
         m_size = offset;
         m_mu.resize(m_n[0], m_n[1], m_n[2]);
-        m_fraction_weights = mode == FluidMode::free_surface ||
-                             weights == ViscosityWeights::volume_fraction;
+        m_fraction_weights =
+            mode == FluidMode::free_surface || weights == ViscosityWeights::volume_fraction;
         m_pointwise_edges = mode == FluidMode::two_phase && weights == ViscosityWeights::pointwise;
         m_mu_gas = mode == FluidMode::two_phase ? phases.mu_gas : 0.0;
         for (std::size_t c = 0; c < m_mu.size(); ++c) {
@@ -131,7 +133,9 @@ public:
                 Index3 lo = f;
                 --lo[a];
                 // An outflow face has its cell on one side only.
-                const double mu_lo = f[a] > 0 ? m_mu(lo[0], lo[1], lo[2]) : 0.0;
+                if (f[a] == 0 && periodic(a))
+                    lo[a] = m_n[a] - 1;  // the seam
+                const double mu_lo = lo[a] >= 0 ? m_mu(lo[0], lo[1], lo[2]) : 0.0;
                 const double mu_hi = f[a] < m_n[a] ? m_mu(f[0], f[1], f[2]) : 0.0;
                 double sum = m_density[flat] + 2.0 * m_dt * (mu_lo + mu_hi) * inv_dx2;
                 for (int b = 0; b < 3; ++b) {
@@ -141,8 +145,11 @@ public:
                     const Array3<double>& weight = m_edge_weight[3 - a - b];
                     Index3 above = f;
                     ++above[b];
-                    const double c_below = (f[b] == 0 ? MIRROR_FACTOR : 1.0);
-                    const double c_above = (above[b] == m_n[b] ? MIRROR_FACTOR : 1.0);
+                    const bool wrap = periodic(b);
+                    const double c_below = (f[b] == 0 && !wrap ? MIRROR_FACTOR : 1.0);
+                    const double c_above = (above[b] == m_n[b] && !wrap ? MIRROR_FACTOR : 1.0);
+                    if (above[b] == m_n[b] && wrap)
+                        above[b] = 0;  // the seam's edge
                     sum += 2.0 * m_dt * inv_dx2 *
                            (weight(f[0], f[1], f[2]) * c_below * c_below +
                             weight(above[0], above[1], above[2]) * c_above * c_above);
@@ -181,9 +188,9 @@ public:
                     if (next[b] >= dims[b] || !m_unknown[face_flat(a, next)])
                         continue;
                     // Along a the two faces share cell f; across b the edge between them.
-                    const double weight =
-                        b == a ? m_mu(f[0], f[1], f[2])
-                               : m_edge_weight[3 - a - b](next[0], next[1], next[2]);
+                    const double weight = b == a
+                                              ? m_mu(f[0], f[1], f[2])
+                                              : m_edge_weight[3 - a - b](next[0], next[1], next[2]);
                     (*off[b])(f[0], f[1], f[2]) = -scale * weight;
                 }
             });
@@ -214,8 +221,8 @@ private:
 
     /// Is face f of component a inside the box or on one of its outflow faces?
     bool solvable(int a, const Index3& f) const {
-        if (f[a] == 0)
-            return m_open[a][0];
+        if (f[a] == 0)  // across a periodic axis the face at 0 is the seam; the one at n its copy
+            return m_open[a][0] || m_periodic[static_cast<std::size_t>(a)];
         return f[a] != m_n[a] || m_open[a][1];
     }
 
@@ -246,6 +253,9 @@ private:
                 Index3 cell = e;
                 cell[a] += da;
                 cell[b] += db;
+                for (int axis : {a, b})  // around the seam's edge the last cells
+                    if (cell[axis] < 0 && periodic(axis))
+                        cell[axis] += m_n[axis];
                 if (m_mu.contains(cell[0], cell[1], cell[2]))
                     visit(cell);
             }
@@ -264,14 +274,19 @@ private:
                         const Index3 e = {i, j, k};
                         double fraction = 1.0;
                         bool free_slip = false;
+                        bool copy = false;  // the seam's edge at n, a copy of the one at 0
                         for (int axis : {a, b}) {
+                            if (periodic(axis)) {
+                                copy |= e[axis] == m_n[axis];
+                                continue;
+                            }
                             if (e[axis] == 0 || e[axis] == m_n[axis]) {
                                 fraction *= HALF;  // half the edge's dual cell is outside
                                 const int side = e[axis] == 0 ? 0 : 1;
                                 free_slip |= walls.at(axis, side) == BoundaryType::free_slip;
                             }
                         }
-                        if (free_slip) {
+                        if (free_slip || copy) {
                             continue;  // zero shear stress on a free-slip wall
                         }
                         if (m_fraction_weights || m_pointwise_edges) {
@@ -326,7 +341,10 @@ private:
                 --lo[a];
                 // An outflow face takes the phase of its one cell.
                 Index3 hi = f;
-                if (f[a] == 0)
+                const bool seam = periodic(a) && f[a] == 0;
+                if (seam)
+                    lo[a] = m_n[a] - 1;
+                else if (f[a] == 0)
                     lo = hi;
                 if (f[a] == m_n[a])
                     hi = lo;
@@ -337,13 +355,12 @@ private:
                 }
                 m_unknown[flat] = 1;
                 const double theta = liquid_fraction(phi_lo, phi_hi);
-                m_density[flat] =
-                    mode == FluidMode::free_surface
-                        ? phases.rho_liquid * std::max(theta, min_liquid_fraction)
-                        : face_density(theta, phases, mode);
+                m_density[flat] = mode == FluidMode::free_surface
+                                      ? phases.rho_liquid * std::max(theta, min_liquid_fraction)
+                                      : face_density(theta, phases, mode);
                 // An outflow face's control volume is the half cell inside the box, like the
                 // half dual cells of the shear terms on it and the pressure's distance Δx/2.
-                if (f[a] == 0 || f[a] == m_n[a])
+                if ((f[a] == 0 && !seam) || f[a] == m_n[a])
                     m_density[flat] *= OUTFLOW_VOLUME_FRACTION;
             });
         }
@@ -362,6 +379,8 @@ private:
                                 const Index3 c = {i, j, k};
                                 Index3 hi = c;
                                 ++hi[a];
+                                if (hi[a] == m_n[a] && periodic(a))
+                                    hi[a] = 0;  // the face at n is the seam's copy
                                 sigma(i, j, k) = scale * m_mu(i, j, k) *
                                                  (x[face_flat(a, hi)] - x[face_flat(a, c)]);
                             }
@@ -374,8 +393,9 @@ private:
     /// Flat-index step of axis `axis` in the face array of component a.
     std::size_t face_stride(int a, int axis) const {
         const Index3& d = m_face_dims[a];
-        return axis == 0 ? 1 : axis == 1 ? static_cast<std::size_t>(d[0])
-                                         : static_cast<std::size_t>(d[0]) * d[1];
+        return axis == 0   ? 1
+               : axis == 1 ? static_cast<std::size_t>(d[0])
+                           : static_cast<std::size_t>(d[0]) * d[1];
     }
 
     /// τ(edge) = 2Δt W_e (∂_b x_a + ∂_a x_b) on edges parallel to c, (a, b) the other axes; ∂
@@ -399,6 +419,10 @@ private:
             const std::size_t step_b = face_stride(b, a);  // x_b along a
             const int n_a = m_n[a];
             const int n_b = m_n[b];
+            const bool wrap_a = periodic(a), wrap_b = periodic(b);
+            // Across a periodic seam (an edge at 0) the derivative reaches back to the last face.
+            const std::size_t seam_a = static_cast<std::size_t>(n_b - 1) * step_a;
+            const std::size_t seam_b = static_cast<std::size_t>(n_a - 1) * step_b;
             tbb::parallel_for(
                 tbb::blocked_range<int>(0, weight.nk()), [&](const tbb::blocked_range<int>& r) {
                     for (int k = r.begin(); k != r.end(); ++k) {
@@ -418,15 +442,15 @@ private:
                                 const std::size_t fa = row_a + i;
                                 const std::size_t fb = row_b + i;
                                 const double d_ab =
-                                    e[b] == 0 ? MIRROR_FACTOR * (x[fa] - a_lo) / m_dx
-                                    : e[b] == n_b
-                                        ? -MIRROR_FACTOR * (x[fa - step_a] - a_hi) / m_dx
-                                        : (x[fa] - x[fa - step_a]) / m_dx;
+                                    e[b] == 0 && wrap_b ? (x[fa] - x[fa + seam_a]) / m_dx
+                                    : e[b] == 0         ? MIRROR_FACTOR * (x[fa] - a_lo) / m_dx
+                                    : e[b] == n_b ? -MIRROR_FACTOR * (x[fa - step_a] - a_hi) / m_dx
+                                                  : (x[fa] - x[fa - step_a]) / m_dx;
                                 const double d_ba =
-                                    e[a] == 0 ? MIRROR_FACTOR * (x[fb] - b_lo) / m_dx
-                                    : e[a] == n_a
-                                        ? -MIRROR_FACTOR * (x[fb - step_b] - b_hi) / m_dx
-                                        : (x[fb] - x[fb - step_b]) / m_dx;
+                                    e[a] == 0 && wrap_a ? (x[fb] - x[fb + seam_b]) / m_dx
+                                    : e[a] == 0         ? MIRROR_FACTOR * (x[fb] - b_lo) / m_dx
+                                    : e[a] == n_a ? -MIRROR_FACTOR * (x[fb - step_b] - b_hi) / m_dx
+                                                  : (x[fb] - x[fb - step_b]) / m_dx;
                                 tau[edge_row + i] = 2.0 * m_dt * w * (d_ab + d_ba);
                             }
                         }
@@ -470,26 +494,33 @@ private:
                                 // Cell f lies above the face, cell f − e_a below it (an outflow
                                 // face has one of them). The flat index of f is formed without
                                 // the array's bounds: on the max face only cell − step is read.
-                                const std::size_t cell =
-                                    static_cast<std::size_t>(i) +
-                                    static_cast<std::size_t>(m_n[0]) *
-                                        (static_cast<std::size_t>(j) +
-                                         static_cast<std::size_t>(m_n[1]) * k);
+                                const std::size_t cell = static_cast<std::size_t>(i) +
+                                                         static_cast<std::size_t>(m_n[0]) *
+                                                             (static_cast<std::size_t>(j) +
+                                                              static_cast<std::size_t>(m_n[1]) * k);
                                 double sum = 0.0;
                                 if (f[a] > 0)
                                     sum += sigma[cell - cell_step] * inv_dx;
+                                else if (periodic(a))  // the seam: the last cell below it
+                                    sum += sigma[cell + (m_n[a] - 1) * cell_step] * inv_dx;
                                 if (f[a] < m_n[a])
                                     sum -= sigma[cell] * inv_dx;
                                 for (int t = 0; t < 2; ++t) {
                                     const int b = other[t];
                                     const Array3<double>& tau = m_shear_stress[3 - a - b];
                                     const std::size_t below = tau.index(i, j, k);
+                                    // Across a periodic b the edge above the last face is the
+                                    // seam's, at 0; no wall there to mirror.
+                                    const bool wrap = periodic(b);
+                                    const bool last = f[b] + 1 == m_n[b];
+                                    const std::size_t above = wrap && last
+                                                                  ? below - f[b] * edge_step[t]
+                                                                  : below + edge_step[t];
                                     const double c_below =
-                                        (f[b] == 0 ? MIRROR_FACTOR : 1.0) * inv_dx;
+                                        (f[b] == 0 && !wrap ? MIRROR_FACTOR : 1.0) * inv_dx;
                                     const double c_above =
-                                        -(f[b] + 1 == m_n[b] ? MIRROR_FACTOR : 1.0) * inv_dx;
-                                    sum += tau[below] * c_below +
-                                           tau[below + edge_step[t]] * c_above;
+                                        -(last && !wrap ? MIRROR_FACTOR : 1.0) * inv_dx;
+                                    sum += tau[below] * c_below + tau[above] * c_above;
                                 }
                                 y[face_row + i] = sum;
                             }
@@ -501,6 +532,10 @@ private:
 
     Index3 m_n{};
     bool m_open[3][2] = {};  ///< outflow faces of the box: their normal velocity is solved for
+    /// periodic axes: the face at 0 is the seam (cells n−1 and 0), the one at n its copy, and
+    /// the edges at 0 are the seam's (those at n copies, weight 0)
+    Periodicity m_periodic = {false, false, false};
+    bool periodic(int axis) const { return m_periodic[static_cast<std::size_t>(axis)]; }
     double m_dx = 0.0;
     double m_dt = 0.0;
     std::array<Index3, 3> m_face_dims{};
@@ -547,9 +582,9 @@ struct OperatorKey {
     std::vector<double> phi;
 
     OperatorKey() = default;
-    OperatorKey(const MacGrid& grid, const PhaseOptions& phases,
-                FluidMode mode_in, const BoundaryOptions& walls_in, double dt_in,
-                double min_fraction, ViscosityWeights weights_in)
+    OperatorKey(const MacGrid& grid, const PhaseOptions& phases, FluidMode mode_in,
+                const BoundaryOptions& walls_in, double dt_in, double min_fraction,
+                ViscosityWeights weights_in)
         : cells{grid.nx(), grid.ny(), grid.nz()},
           dx(grid.dx()),
           dt(dt_in),
@@ -568,8 +603,7 @@ struct OperatorKey {
         return cells == o.cells && dx == o.dx && dt == o.dt &&
                min_liquid_fraction == o.min_liquid_fraction && rho_liquid == o.rho_liquid &&
                rho_gas == o.rho_gas && mu_liquid == o.mu_liquid && mu_gas == o.mu_gas &&
-               mode == o.mode && walls == o.walls && weights == o.weights &&
-               surface == o.surface;
+               mode == o.mode && walls == o.walls && weights == o.weights && surface == o.surface;
     }
 };
 
@@ -592,8 +626,7 @@ ViscositySolver& ViscositySolver::operator=(ViscositySolver&&) noexcept = defaul
 SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interface,
                                    const PhaseOptions& phases, FluidMode mode,
                                    const BoundaryOptions& walls, double dt,
-                                   const ViscosityOptions& options,
-                                   double min_liquid_fraction) {
+                                   const ViscosityOptions& options, double min_liquid_fraction) {
     options.validate();
     walls.validate();
     interface.validate(grid);
@@ -617,8 +650,8 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     ViscousOperator& op = ws.op;
     OperatorKey key(grid, viscous_phases, mode, walls, dt, min_liquid_fraction, options.weights);
     key.surface = surface;
-    const bool reuse = !ws.key.phi.empty() && ws.key.same_settings(key) &&
-                       ws.key.phi == interface.phi.storage();
+    const bool reuse =
+        !ws.key.phi.empty() && ws.key.same_settings(key) && ws.key.phi == interface.phi.storage();
     if (!reuse) {
         ws.key.phi.clear();  // nothing valid until the build is complete
         ws.diagonal.clear();
@@ -719,13 +752,25 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         x[f] += fixed[f];
     }
     op.scatter(x, grid);
+    for (int axis = 0; axis < 3; ++axis) {  // the faces at n of periodic axes repeat those at 0
+        if (!walls.periodic(axis))
+            continue;
+        Array3<double>& faces = grid.velocity(axis);
+        for (int k = 0; k < (axis == 2 ? 1 : faces.nk()); ++k)
+            for (int j = 0; j < (axis == 1 ? 1 : faces.nj()); ++j)
+                for (int i = 0; i < (axis == 0 ? 1 : faces.ni()); ++i) {
+                    Index3 copy = {i, j, k};
+                    copy[static_cast<std::size_t>(axis)] = grid.cells(axis);
+                    faces(copy[0], copy[1], copy[2]) = faces(i, j, k);
+                }
+    }
     return result;
 }
 
 SolveResult apply_viscosity(MacGrid& grid, const InterfaceInput& interface,
-                            const PhaseOptions& phases, FluidMode mode, const BoundaryOptions& walls,
-                            double dt, const ViscosityOptions& options,
-                            double min_liquid_fraction) {
+                            const PhaseOptions& phases, FluidMode mode,
+                            const BoundaryOptions& walls, double dt,
+                            const ViscosityOptions& options, double min_liquid_fraction) {
     ViscositySolver solver;
     return solver.solve(grid, interface, phases, mode, walls, dt, options, min_liquid_fraction);
 }

@@ -14,7 +14,9 @@
 /// its diagonal (ViscosityOptions::preconditioner), starting from u* (TBB-parallel operator).
 ///
 /// Boundaries: the normal faces of walls and inflows keep their stored value; those of an outflow
-/// are unknowns with no strain beyond them (zero normal gradient). On a no-slip wall or an
+/// are unknowns with no strain beyond them (zero normal gradient); across a periodic pair the face
+/// at 0 is an unknown between cells n−1 and 0 (the face at n is set to it), and the strain rates
+/// at the seam's cells and edges reach across it. On a no-slip wall or an
 /// inflow the tangential velocity is mirrored with opposite sign (zero at the face, or the
 /// velocity of a moving wall) and the edge terms on that face are weighted by the half of their
 /// dual cell inside the box; on a free-slip wall or an outflow (zero normal gradient) the shear

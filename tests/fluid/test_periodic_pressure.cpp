@@ -321,8 +321,7 @@ TEST(PeriodicPreconditioners, MultigridKeepsItsIterationCountAcrossSeams) {
     }
 }
 
-// A periodic face is paired with its opposite, and the errors say which and with what; the
-// fluid step refuses periodic faces (the pressure alone handles them so far) naming the field.
+// A periodic face is paired with its opposite, and the errors say which and with what.
 TEST(PeriodicBoundaries, ErrorsNameTheFaceAndTheConflict) {
     BoundaryOptions boundaries = BoundaryOptions::all(BoundaryType::no_slip);
     boundaries.y_min.type = BoundaryType::periodic;
@@ -336,17 +335,9 @@ TEST(PeriodicBoundaries, ErrorsNameTheFaceAndTheConflict) {
     }
     boundaries.y_max.type = BoundaryType::periodic;
     EXPECT_NO_THROW(boundaries.validate());
-    FluidOptions options;
+    FluidOptions options;  // the fluid step takes them
     options.boundaries = boundaries;
-    try {
-        options.validate();
-        FAIL() << "the fluid step does not wrap yet";
-    } catch (const std::invalid_argument& e) {
-        EXPECT_EQ(
-            std::string(e.what()).rfind("boundaries/y_min: periodic faces are not available", 0),
-            0u)
-            << e.what();
-    }
+    EXPECT_NO_THROW(options.validate());
 }
 
 // The max face of a periodic pair repeats the min face after apply_boundary_velocity(), and
