@@ -54,16 +54,8 @@ bool is_fixed_sample(FieldLocation location, const Array3<double>& field, int i,
 /// Along a periodic axis, the face samples at n of a face field of that axis repeat those at 0.
 void copy_seam(FieldLocation location, const Periodicity& periodic, Array3<double>& field) {
     const int axis = face_axis(location);
-    if (axis < 0 || !periodic[static_cast<std::size_t>(axis)])
-        return;
-    const int last = (axis == 0 ? field.ni() : (axis == 1 ? field.nj() : field.nk())) - 1;
-    for (int k = 0; k < (axis == 2 ? 1 : field.nk()); ++k)
-        for (int j = 0; j < (axis == 1 ? 1 : field.nj()); ++j)
-            for (int i = 0; i < (axis == 0 ? 1 : field.ni()); ++i) {
-                std::array<int, 3> copy = {i, j, k};
-                copy[static_cast<std::size_t>(axis)] = last;
-                field(copy[0], copy[1], copy[2]) = field(i, j, k);
-            }
+    if (axis >= 0 && periodic[static_cast<std::size_t>(axis)])
+        copy_seam_faces(field, axis);
 }
 
 /// The inflow faces across which a component's samples are tangential: for each, the axis, the

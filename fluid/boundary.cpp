@@ -277,11 +277,7 @@ void apply_boundary_velocity(MacGrid& grid, const BoundaryOptions& boundaries, d
             const int inward = side == 0 ? 1 : -1;
             if (type == BoundaryType::periodic) {
                 if (side == 1)  // the max face is the min face's copy
-                    for_each_boundary_face(grid, axis, side, [&](int i, int j, int k) {
-                        int first[3] = {i, j, k};
-                        first[axis] = 0;
-                        faces(i, j, k) = faces(first[0], first[1], first[2]);
-                    });
+                    copy_seam_faces(faces, axis);
                 continue;
             }
             for_each_boundary_face(grid, axis, side, [&](int i, int j, int k) {

@@ -93,13 +93,7 @@ void extrapolate_velocity(MacGrid& grid, const InterfaceInput& interface, int la
             }
         }
         if (seam)  // the faces at n repeat those at 0
-            for (int k = 0; k < (a == 2 ? 1 : faces.nk()); ++k)
-                for (int j = 0; j < (a == 1 ? 1 : faces.nj()); ++j)
-                    for (int i = 0; i < (a == 0 ? 1 : faces.ni()); ++i) {
-                        std::array<int, 3> copy = {i, j, k};
-                        copy[static_cast<std::size_t>(a)] = n_axis;
-                        faces(copy[0], copy[1], copy[2]) = faces(i, j, k);
-                    }
+            copy_seam_faces(faces, a);
     }
 }
 

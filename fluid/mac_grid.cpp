@@ -148,6 +148,17 @@ TrilinearSample sample_trilinear(const Array3<double>& field, FieldLocation loca
     return sample;
 }
 
+void copy_seam_faces(Array3<double>& faces, int axis) {
+    const int last = (axis == 0 ? faces.ni() : (axis == 1 ? faces.nj() : faces.nk())) - 1;
+    for (int k = 0; k < (axis == 2 ? 1 : faces.nk()); ++k)
+        for (int j = 0; j < (axis == 1 ? 1 : faces.nj()); ++j)
+            for (int i = 0; i < (axis == 0 ? 1 : faces.ni()); ++i) {
+                std::array<int, 3> copy = {i, j, k};
+                copy[static_cast<std::size_t>(axis)] = last;
+                faces(copy[0], copy[1], copy[2]) = faces(i, j, k);
+            }
+}
+
 MacGrid::MacGrid(int nx, int ny, int nz, double dx, const Eigen::Vector3d& origin)
     : m_nx(nx), m_ny(ny), m_nz(nz), m_dx(dx), m_origin(origin) {
     if (nx < 1 || ny < 1 || nz < 1) {

@@ -54,6 +54,10 @@ TrilinearSample sample_trilinear(const Array3<double>& field, FieldLocation loca
                                  const Eigen::Vector3d& grid_position,
                                  const Periodicity& periodic = {});
 
+/// Sets the samples of `faces` (a face field along `axis`, n+1 samples along it) at index n to
+/// those at 0: along a periodic axis the face at n is the copy of the seam's face at 0.
+void copy_seam_faces(Array3<double>& faces, int axis);
+
 /// The value of sample_trilinear() alone (cheaper: no stencil bounds).
 double interpolate_trilinear(const Array3<double>& field, FieldLocation location,
                              const Eigen::Vector3d& grid_position,

@@ -752,18 +752,9 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         x[f] += fixed[f];
     }
     op.scatter(x, grid);
-    for (int axis = 0; axis < 3; ++axis) {  // the faces at n of periodic axes repeat those at 0
-        if (!walls.periodic(axis))
-            continue;
-        Array3<double>& faces = grid.velocity(axis);
-        for (int k = 0; k < (axis == 2 ? 1 : faces.nk()); ++k)
-            for (int j = 0; j < (axis == 1 ? 1 : faces.nj()); ++j)
-                for (int i = 0; i < (axis == 0 ? 1 : faces.ni()); ++i) {
-                    Index3 copy = {i, j, k};
-                    copy[static_cast<std::size_t>(axis)] = grid.cells(axis);
-                    faces(copy[0], copy[1], copy[2]) = faces(i, j, k);
-                }
-    }
+    for (int axis = 0; axis < 3; ++axis)  // the faces at n of periodic axes repeat those at 0
+        if (walls.periodic(axis))
+            copy_seam_faces(grid.velocity(axis), axis);
     return result;
 }
 
