@@ -239,8 +239,10 @@ void take_seam_planes(const PoissonMatrix& a, const std::vector<double>& x, Seam
 
 /// One red–black Gauss–Seidel half sweep over cells with (i + j + k) % 2 == colour. Neighbours
 /// across a periodic seam are read from `seams` (take_seam_planes() of x before the sweep).
-void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::vector<double>& x,
-                   int colour, SeamPlanes& seams) {
+/// `Wrap` false compiles the loop without the seam's branches (bounded boxes keep the old speed).
+template <bool Wrap>
+void smooth_colour_kernel(const PoissonMatrix& a, const std::vector<double>& b,
+                          std::vector<double>& x, int colour, SeamPlanes& seams) {
     const int ni = a.ni(), nj = a.nj(), nk = a.nk();
     const std::size_t sj = static_cast<std::size_t>(ni);
     const std::size_t sk = static_cast<std::size_t>(ni) * nj;
@@ -250,8 +252,8 @@ void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::ve
     const double* a_z = a.off_z.data();
     const double* bv = b.data();
     double* xv = x.data();
-    const bool px = a.periodic[0], py = a.periodic[1], pz = a.periodic[2];
-    if (a.any_periodic())
+    const bool px = Wrap && a.periodic[0], py = Wrap && a.periodic[1], pz = Wrap && a.periodic[2];
+    if (Wrap)
         take_seam_planes(a, x, seams);
     tbb::parallel_for(tbb::blocked_range<int>(0, nk), [&](const tbb::blocked_range<int>& range) {
         for (int k = range.begin(); k != range.end(); ++k) {
@@ -265,28 +267,28 @@ void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::ve
                     double sum = bv[c];
                     if (i + 1 < ni)
                         sum -= a_x[c] * xv[c + 1];
-                    else if (px)
+                    else if (Wrap && px)
                         sum -= a_x[c] * seams.first[0][plane_index(0, i, j, k, ni, nj)];
                     if (i > 0)
                         sum -= a_x[c - 1] * xv[c - 1];
-                    else if (px)
+                    else if (Wrap && px)
                         sum -= a_x[c + sj - 1] * seams.last[0][plane_index(0, i, j, k, ni, nj)];
                     if (j + 1 < nj)
                         sum -= a_y[c] * xv[c + sj];
-                    else if (py)
+                    else if (Wrap && py)
                         sum -= a_y[c] * seams.first[1][plane_index(1, i, j, k, ni, nj)];
                     if (j > 0)
                         sum -= a_y[c - sj] * xv[c - sj];
-                    else if (py)
+                    else if (Wrap && py)
                         sum -=
                             a_y[c + sj * (nj - 1)] * seams.last[1][plane_index(1, i, j, k, ni, nj)];
                     if (k + 1 < nk)
                         sum -= a_z[c] * xv[c + sk];
-                    else if (pz)
+                    else if (Wrap && pz)
                         sum -= a_z[c] * seams.first[2][plane_index(2, i, j, k, ni, nj)];
                     if (k > 0)
                         sum -= a_z[c - sk] * xv[c - sk];
-                    else if (pz)
+                    else if (Wrap && pz)
                         sum -=
                             a_z[c + sk * (nk - 1)] * seams.last[2][plane_index(2, i, j, k, ni, nj)];
                     xv[c] = sum / a_d[c];
@@ -294,6 +296,14 @@ void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::ve
             }
         }
     });
+}
+
+void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::vector<double>& x,
+                   int colour, SeamPlanes& seams) {
+    if (a.any_periodic())
+        smooth_colour_kernel<true>(a, b, x, colour, seams);
+    else
+        smooth_colour_kernel<false>(a, b, x, colour, seams);
 }
 
 /// The first red half-sweep from x = 0: x = b / A_cc on red active cells, 0 elsewhere (same

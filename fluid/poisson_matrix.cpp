@@ -31,20 +31,24 @@ std::size_t PoissonMatrix::active_count() const {
     return count;
 }
 
-void PoissonMatrix::apply(const std::vector<double>& x, std::vector<double>& y) const {
-    const int n_i = ni(), n_j = nj(), n_k = nk();
-    y.resize(size());
+namespace {
+
+/// y = A x; `Wrap` false compiles the loop without the seam's branches.
+template <bool Wrap>
+void apply_kernel(const PoissonMatrix& a, const std::vector<double>& x, std::vector<double>& y) {
+    const int n_i = a.ni(), n_j = a.nj(), n_k = a.nk();
+    y.resize(a.size());
     const std::size_t sj = static_cast<std::size_t>(n_i);
     const std::size_t sk = static_cast<std::size_t>(n_i) * n_j;
-    const double* a_d = diag.data();
-    const double* a_x = off_x.data();
-    const double* a_y = off_y.data();
-    const double* a_z = off_z.data();
+    const double* a_d = a.diag.data();
+    const double* a_x = a.off_x.data();
+    const double* a_y = a.off_y.data();
+    const double* a_z = a.off_z.data();
     const double* xv = x.data();
     double* yv = y.data();
     // Distance back to the first cell from the last along each axis (the periodic seam).
     const std::size_t wrap_x = sj - 1, wrap_y = sj * (n_j - 1), wrap_z = sk * (n_k - 1);
-    const bool px = periodic[0], py = periodic[1], pz = periodic[2];
+    const bool px = Wrap && a.periodic[0], py = Wrap && a.periodic[1], pz = Wrap && a.periodic[2];
     tbb::parallel_for(tbb::blocked_range<int>(0, n_k), [&](const tbb::blocked_range<int>& range) {
         for (int k = range.begin(); k != range.end(); ++k) {
             for (int j = 0; j < n_j; ++j) {
@@ -58,33 +62,42 @@ void PoissonMatrix::apply(const std::vector<double>& x, std::vector<double>& y) 
                     double sum = a_d[c] * xv[c];
                     if (i + 1 < n_i)
                         sum += a_x[c] * xv[c + 1];
-                    else if (px)
+                    else if (Wrap && px)
                         sum += a_x[c] * xv[c - wrap_x];
                     if (i > 0)
                         sum += a_x[c - 1] * xv[c - 1];
-                    else if (px)
+                    else if (Wrap && px)
                         sum += a_x[c + wrap_x] * xv[c + wrap_x];
                     if (j + 1 < n_j)
                         sum += a_y[c] * xv[c + sj];
-                    else if (py)
+                    else if (Wrap && py)
                         sum += a_y[c] * xv[c - wrap_y];
                     if (j > 0)
                         sum += a_y[c - sj] * xv[c - sj];
-                    else if (py)
+                    else if (Wrap && py)
                         sum += a_y[c + wrap_y] * xv[c + wrap_y];
                     if (k + 1 < n_k)
                         sum += a_z[c] * xv[c + sk];
-                    else if (pz)
+                    else if (Wrap && pz)
                         sum += a_z[c] * xv[c - wrap_z];
                     if (k > 0)
                         sum += a_z[c - sk] * xv[c - sk];
-                    else if (pz)
+                    else if (Wrap && pz)
                         sum += a_z[c + wrap_z] * xv[c + wrap_z];
                     yv[c] = sum;
                 }
             }
         }
     });
+}
+
+}  // namespace
+
+void PoissonMatrix::apply(const std::vector<double>& x, std::vector<double>& y) const {
+    if (any_periodic())
+        apply_kernel<true>(*this, x, y);
+    else
+        apply_kernel<false>(*this, x, y);
 }
 
 PoissonMatrix PoissonMatrix::without_wrap() const {
