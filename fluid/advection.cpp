@@ -71,8 +71,7 @@ std::vector<TangentialInflow> tangential_inflows(const MacGrid& grid, FieldLocat
     std::vector<TangentialInflow> faces;
     if (!boundaries || location == FieldLocation::cell_centre)
         return faces;
-    const int component =
-        location == FieldLocation::x_face ? 0 : (location == FieldLocation::y_face ? 1 : 2);
+    const int component = face_axis(location);
     for (int axis = 0; axis < 3; ++axis)
         for (int side = 0; side < 2; ++side)
             if (axis != component && boundaries->at(axis, side) == BoundaryType::inflow)

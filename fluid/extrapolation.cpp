@@ -23,10 +23,9 @@ void extrapolate_velocity(MacGrid& grid, const InterfaceInput& interface, int la
     const Periodicity& periodic = grid.periodic();
     const std::array<int, 3> cells = {grid.nx(), grid.ny(), grid.nz()};
     for (int a = 0; a < 3; ++a) {
-        const bool seam =
-            periodic[static_cast<std::size_t>(a)] && cells[static_cast<std::size_t>(a)] > 1;
         Array3<double>& faces = grid.velocity(a);
         const int n_axis = grid.cells(a);
+        const bool seam = periodic[static_cast<std::size_t>(a)] && n_axis > 1;
         Array3<std::uint8_t> state(faces.ni(), faces.nj(), faces.nk(), UNKNOWN);
         for (int k = 0; k < faces.nk(); ++k) {
             for (int j = 0; j < faces.nj(); ++j) {

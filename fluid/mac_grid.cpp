@@ -55,12 +55,6 @@ FieldLocation face_location(int axis) {
 
 namespace {
 
-/// The face location of axis a (face_location() without its range check).
-FieldLocation face_location_of(int a) {
-    return a == 0 ? FieldLocation::x_face
-                  : (a == 1 ? FieldLocation::y_face : FieldLocation::z_face);
-}
-
 /// The 8 samples around a point and its fractional position between them.
 struct Stencil {
     double c[8];  ///< (x, y, z) corners in the order 000, 100, 010, 110, 001, 101, 011, 111
@@ -88,7 +82,7 @@ Stencil gather_stencil(const Array3<double>& field, FieldLocation location,
             const auto ax = static_cast<std::size_t>(a);
             if (periodic[ax]) {
                 // A face field along its own axis holds the seam twice (0 and n).
-                const int period = location == face_location_of(a) ? n[ax] - 1 : n[ax];
+                const int period = location == face_location(a) ? n[ax] - 1 : n[ax];
                 split_periodic(s[a], period, lo[ax], hi[ax], *fraction[a]);
             } else {
                 split_coordinate(s[a], n[ax], lo[ax], *fraction[a]);

@@ -327,13 +327,9 @@ void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
                         break;
                 }
                 velocity(i, j, k) -= scale * face.beta * difference;
-                if ((axis == 0 ? i : (axis == 1 ? j : k)) ==
-                    0) {  // a seam: its copy on the max side
-                    std::array<int, 3> copy = {i, j, k};
-                    copy[static_cast<std::size_t>(axis)] = grid.cells(axis);
-                    velocity(copy[0], copy[1], copy[2]) = velocity(i, j, k);
-                }
             });
+        if (boundaries.periodic(axis))  // the seam's copy on the max side
+            copy_seam_faces(velocity, axis);
     }
     for_each_outflow_face(
         grid, interface, phases, mode, boundaries,

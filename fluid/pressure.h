@@ -16,9 +16,10 @@
 /// the face keeps its zero-gradient velocity (Neumann), so the Laplace pressure inside it is not
 /// pinned to the ambient pressure. Across a periodic pair of faces cell n−1 and cell 0 are
 /// neighbours through the min face, whose velocity takes the gradient like an interior face's and
-/// is copied to the max face (PoissonMatrix::periodic). In free_surface mode only liquid cells are unknowns; a face to
-/// a gas cell uses the ghost value that puts p = σκ at the θ-weighted interface position, adding
-/// β/θ to the diagonal (θ clamped below by min_liquid_fraction). Pressure in Pa.
+/// is copied to the max face (PoissonMatrix::periodic). In free_surface mode only liquid cells
+/// are unknowns; a face to a gas cell uses the ghost value that puts p = σκ at the θ-weighted
+/// interface position, adding β/θ to the diagonal (θ clamped below by min_liquid_fraction).
+/// Pressure in Pa.
 
 #include <memory>
 #include <vector>

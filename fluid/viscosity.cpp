@@ -222,7 +222,7 @@ private:
     /// Is face f of component a inside the box or on one of its outflow faces?
     bool solvable(int a, const Index3& f) const {
         if (f[a] == 0)  // across a periodic axis the face at 0 is the seam; the one at n its copy
-            return m_open[a][0] || m_periodic[static_cast<std::size_t>(a)];
+            return m_open[a][0] || periodic(a);
         return f[a] != m_n[a] || m_open[a][1];
     }
 
