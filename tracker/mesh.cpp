@@ -130,7 +130,9 @@ SurfaceMesh::SurfaceMesh(const SurfaceMesh& other)
       m_edges(other.m_edges),
       m_edge_triangles(other.m_edge_triangles),
       m_vertex_triangles(other.m_vertex_triangles),
-      m_vertex_edges(other.m_vertex_edges) {}
+      m_vertex_edges(other.m_vertex_edges),
+      m_periods(other.m_periods),
+      m_periodic(other.m_periodic) {}
 
 SurfaceMesh& SurfaceMesh::operator=(const SurfaceMesh& other) {
     if (this != &other) {
@@ -170,6 +172,33 @@ void SurfaceMesh::set_positions(const std::vector<Vec3>& p) {
                                     " positions for " + std::to_string(m_positions.size()) +
                                     " vertices");
     m_positions = p;
+}
+
+void SurfaceMesh::set_periods(const MeshPeriods& periods) {
+    periods.validate();
+    m_periods = periods;
+    m_periodic = periods.any();
+    wrap_positions();
+}
+
+void SurfaceMesh::wrap_positions() {
+    if (!m_periodic)
+        return;
+    for (size_t i = 0; i < m_positions.size(); ++i)
+        if (m_vertex_alive[i])
+            m_positions[i] = m_periods.wrap(m_positions[i]);
+}
+
+std::array<Vec3, 3> SurfaceMesh::triangle_positions(int ti) const {
+    const Triangle& t = triangle(ti);
+    const Vec3& a = position(t[0]);
+    return {a, position_near(t[1], a), position_near(t[2], a)};
+}
+
+std::array<Vec3, 2> SurfaceMesh::edge_positions(int ei) const {
+    const Edge& e = edge(ei);
+    const Vec3& a = position(e[0]);
+    return {a, position_near(e[1], a)};
 }
 
 int SurfaceMesh::find_edge(int v0, int v1) const {
@@ -714,6 +743,8 @@ void SurfaceMesh::load_state(BinaryReader& in) {
     m.m_vertex_marked.assign(nv, 1);
     m.m_triangle_marked.assign(nt, 1);
     m.m_observers = std::move(m_observers);
+    m.m_periods = m_periods;
+    m.m_periodic = m_periodic;
     *this = std::move(m);
 }
 

@@ -15,6 +15,7 @@
 /// exactly one triangle.
 
 #include "common/binary_io.h"
+#include "tracker/periods.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -104,6 +105,24 @@ public:
     const std::vector<Vec3>& positions() const { return m_positions; }
     /// Replaces all positions at once; `p.size()` must equal num_vertices() (else throws).
     void set_positions(const std::vector<Vec3>& p);
+
+    // ---- periodic meshes (periods.h) -----------------------------------------------------
+    /// The box the mesh wraps around; no axis wraps by default.
+    const MeshPeriods& periods() const { return m_periods; }
+    bool periodic() const { return m_periodic; }
+    /// Sets the periods (validated, else throws std::invalid_argument) and moves every live
+    /// vertex into the fundamental box. Elements are read by the minimum image from then on.
+    void set_periods(const MeshPeriods& periods);
+    /// Moves every live vertex into the fundamental box (after a motion; no-op if not periodic).
+    void wrap_positions();
+    /// Vertex vi's position at its image nearest `reference` (its position if not periodic).
+    Vec3 position_near(int vi, const Vec3& reference) const {
+        return m_periodic ? m_periods.nearest_image(position(vi), reference) : position(vi);
+    }
+    /// Triangle ti's corners, each at its image nearest the first corner.
+    std::array<Vec3, 3> triangle_positions(int ti) const;
+    /// Edge ei's ends, the second at its image nearest the first.
+    std::array<Vec3, 2> edge_positions(int ei) const;
 
     // ---- connectivity ------------------------------------------------------------------
     const Triangle& triangle(int ti) const { return m_triangles[static_cast<size_t>(ti)]; }
@@ -201,7 +220,8 @@ public:
     /// rebuilds a mesh on which every later operation does exactly what it would have done here.
     void save_state(BinaryWriter& out) const;
     /// Replaces this mesh's contents by a state save_state() wrote, keeping its observers (they
-    /// are not told: the caller restores their state too). Throws FormatError if the data is
+    /// are not told: the caller restores their state too) and its periods (set by whoever built
+    /// the mesh, as its observers are). Throws FormatError if the data is
     /// truncated or inconsistent (sizes that disagree, an index out of range), leaving the mesh
     /// unchanged.
     void load_state(BinaryReader& in);
@@ -231,6 +251,8 @@ private:
     std::vector<std::vector<int>> m_vertex_triangles;
     std::vector<std::vector<int>> m_vertex_edges;
     std::vector<MeshObserver*> m_observers;  // copies of a mesh start with none
+    MeshPeriods m_periods;
+    bool m_periodic = false;  // m_periods.any(), cached for the accessors
 };
 
 }  // namespace meniscus::tracker
