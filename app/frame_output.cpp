@@ -3,6 +3,7 @@
 #include "app/checkpoint.h"
 
 #include "common/atomic_file.h"
+#include "coupling/periodic_images.h"
 #include "tracker/mesh_io.h"
 #include "tracker/topology/separate.h"
 
@@ -118,11 +119,18 @@ std::vector<std::string> remove_frames_after(const std::string& dir, int frame) 
 }
 
 OutputSurface output_surface(const tracker::SurfaceMesh& mesh,
-                             const std::vector<tracker::Vec3>& velocities, double length_scale) {
+                             const std::vector<tracker::Vec3>& velocities, double length_scale,
+                             double periodic_margin) {
     OutputSurface out;
-    out.mesh = mesh;
     out.velocities = velocities;
     out.velocities.resize(static_cast<size_t>(mesh.num_vertices()), tracker::Vec3::Zero());
+    if (mesh.periodic()) {
+        coupling::UnrolledMesh unrolled = coupling::unroll_periodic_mesh(mesh, periodic_margin);
+        out.velocities = coupling::unrolled_values(unrolled, out.velocities);
+        out.mesh = std::move(unrolled.mesh);
+    } else {
+        out.mesh = mesh;
+    }
     const tracker::EdgeManifoldReport split = tracker::make_edge_manifold(out.mesh);
     out.nonmanifold_edges = split.nonmanifold_edges;
     out.vertices_split = split.vertices_split;
@@ -180,7 +188,10 @@ std::vector<std::string> write_frame_files(const std::string& dir, int frame,
         if (o.vdb) {
             // The VDB's signs come from the same fans the PLY is split into (lengths in metres;
             // the writer scales them).
-            const OutputSurface surface = output_surface(mesh, {}, 1.0);
+            // A periodic mesh's images reach past the box by the band, so the distances near
+            // its faces see the surface beyond them.
+            const double margin = (format.vdb.half_width_voxels + 2.0) * format.vdb.voxel_size;
+            const OutputSurface surface = output_surface(mesh, {}, 1.0, margin);
             written.push_back(frame_path(dir, "fields", frame, "vdb"));
             coupling::write_surface_vdb(written.back(), surface.mesh, format.vdb, fluid);
         }

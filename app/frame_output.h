@@ -46,6 +46,9 @@ std::vector<std::string> remove_frames_after(const std::string& dir, int frame);
 /// mid-pinch, split at their midpoints, singular vertices split into one copy per fan, nothing
 /// moved), so that each edge has exactly two triangles; positions and velocities multiplied by
 /// `length_scale` (output units per metre). The enclosed volume changes by round-off only.
+/// A periodic mesh is written unrolled (coupling/periodic_images.h): every image of each triangle
+/// that reaches into the box grown by `periodic_margin` (m), so the surface covers the box to its
+/// faces; a triangle across a face of the box is there at both of its images.
 struct OutputSurface {
     tracker::SurfaceMesh mesh;
     std::vector<tracker::Vec3> velocities;  ///< per vertex of `mesh`, output units per second
@@ -53,7 +56,8 @@ struct OutputSurface {
     int vertices_split = 0;                 ///< singular vertices split into one copy per fan
 };
 OutputSurface output_surface(const tracker::SurfaceMesh& mesh,
-                             const std::vector<tracker::Vec3>& velocities, double length_scale);
+                             const std::vector<tracker::Vec3>& velocities, double length_scale,
+                             double periodic_margin = 0.0);
 
 /// How a scene's frames are written: the VDB writer's options (lengths still in metres, with
 /// length_scale set) and the length unit.

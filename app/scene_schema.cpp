@@ -50,8 +50,9 @@ template <typename V>
 void visit_fields(V& v, fluid::FaceBoundary& o) {
     enum_field(v, "type", o.type, BOUNDARY_TYPES,
                "free_slip or no_slip wall, inflow (a prescribed velocity into the box), outflow "
-               "(fixed pressure, zero-gradient velocity) or periodic (with the opposite face; "
-               "not available in scenes yet: the surface mesh does not wrap)");
+               "(fixed pressure, zero-gradient velocity) or periodic (with the opposite face: the "
+               "surface mesh wraps around the box too; needs /surface/shape, periodic along "
+               "that axis, and no inflow or outflow face)");
     v.vec3("velocity", o.velocity, Range::any(), "m/s",
            "no_slip: the wall's velocity along itself (a moving wall; normal component 0)");
     v.number("pressure", o.pressure, Range::any(), "Pa", "outflow: the pressure on the face");

@@ -77,6 +77,7 @@ SurfaceMesh build_initial_surface_geometry(const Scene& scene, std::string* repo
         options.remesh_iterations = scene.surface.remesh_iterations;
         options.crease = scene.surface.crease;
         options.cancel = scene.cancel;
+        options.periods = scene_periods(scene);
         tracker::ImplicitMeshReport r;
         SurfaceMesh mesh;
         try {
@@ -148,16 +149,32 @@ void apply_initial_velocity(const std::vector<VelocityRegion>& regions, fluid::M
     }
 }
 
-/// Periodic faces: the fluid step handles them, the surface mesh does not wrap around
-/// the box yet, so a scene cannot use them. Throws InputError naming the face.
-void check_no_periodic_faces(const Scene& scene) {
+/// Periodic faces with what does not wrap around the box yet: a surface read from a file (its
+/// connectivity cannot close across the faces), inflow and outflow faces (the nozzle's mesh and
+/// the clipping), semi-implicit surface tension. Throws InputError naming the face.
+void check_periodic_faces(const Scene& scene) {
     static const char* const faces[3] = {"x_min", "y_min", "z_min"};
+    int periodic = -1;
     for (int axis = 0; axis < 3; ++axis)
-        if (scene.fluid.boundaries.periodic(axis))
-            throw InputError(scene.source_path + ": /fluid/boundaries/" + faces[axis] +
-                             ": periodic faces are not available in scenes yet: the fluid step "
-                             "handles them, the surface mesh does not wrap "
-                             "around the box (issue 39); use free_slip walls");
+        if (scene.fluid.boundaries.periodic(axis) && periodic < 0)
+            periodic = axis;
+    if (periodic < 0)
+        return;
+    const std::string where =
+        scene.source_path + ": /fluid/boundaries/" + faces[periodic] + ": periodic faces ";
+    if (!scene.shape)
+        throw InputError(where +
+                         "need the surface as /surface/shape (a mesh file cannot be "
+                         "closed across the box's faces)");
+    if (scene.fluid.boundaries.inflow() || scene.fluid.boundaries.open())
+        throw InputError(where + "are not available together with inflow or outflow faces yet");
+    if (scene.coupling.simulation.implicit_tension > 0.0)
+        throw InputError(where + "are not available with /coupling/implicit_tension yet");
+    if (scene.fluid.boundaries.periodic(0) && scene.fluid.boundaries.periodic(1) &&
+        scene.fluid.boundaries.periodic(2))
+        throw InputError(where +
+                         "may wrap two axes at most: the enclosed volume is measured "
+                         "along an axis that does not wrap");
 }
 
 /// Each inflow lets in the phase the surface puts at its region's centre, half a cell inside
@@ -194,6 +211,32 @@ void check_inflow_phases(const Scene& scene, const SurfaceMesh& mesh, const flui
 }
 
 }  // namespace
+
+int fluid_cells_along(const Scene& scene, int axis) {
+    const double dx = scene.domain.size.x() / scene.domain.cells;
+    if (axis == 0)
+        return scene.domain.cells;
+    static const char* const keys[3] = {"/domain/size/0", "/domain/size/1", "/domain/size/2"};
+    const double n = std::round(scene.domain.size[axis] / dx);
+    if (!(n <= MAX_CELLS_PER_AXIS))
+        throw InputError(scene.source_path + ": " + keys[axis] + ": " + std::to_string(n) +
+                         " cells of the /domain cell size; at most " +
+                         std::to_string(MAX_CELLS_PER_AXIS));
+    return std::max(1, static_cast<int>(n));
+}
+
+tracker::MeshPeriods scene_periods(const Scene& scene) {
+    tracker::MeshPeriods periods;
+    if (scene.flow.type != "fluid")
+        return periods;
+    const double dx = scene.domain.size.x() / scene.domain.cells;
+    for (int axis = 0; axis < 3; ++axis)
+        if (scene.fluid.boundaries.periodic(axis)) {
+            periods.origin[axis] = scene.domain.min[axis];
+            periods.length[axis] = fluid_cells_along(scene, axis) * dx;
+        }
+    return periods;
+}
 
 tracker::TrackerOptions tracker_options(const Scene& scene, double nominal_xi) {
     tracker::TrackerOptions options = scene.tracker;
@@ -249,22 +292,13 @@ SurfaceMesh checked_initial_surface(const Scene& scene, const ResourceLimits& li
 
 coupling::Simulation make_fluid_simulation(const Scene& scene, SurfaceMesh initial,
                                            double nominal_xi) {
-    check_no_periodic_faces(scene);
+    check_periodic_faces(scene);
     const double dx = scene.domain.size.x() / scene.domain.cells;
-    const auto cells_along = [&](double size, const char* key) {
-        const double n = std::round(size / dx);
-        if (!(n <= MAX_CELLS_PER_AXIS))
-            throw InputError(scene.source_path + ": " + key + ": " + std::to_string(n) +
-                             " cells of the /domain cell size; at most " +
-                             std::to_string(MAX_CELLS_PER_AXIS));
-        return std::max(1, static_cast<int>(n));
-    };
     fluid::FluidOptions options = scene.fluid;
     options.pressure.iteration.cancel = scene.cancel;
     options.viscosity.iteration.cancel = scene.cancel;
-    fluid::FluidSolver solver(
-        scene.domain.cells, cells_along(scene.domain.size.y(), "/domain/size/1"),
-        cells_along(scene.domain.size.z(), "/domain/size/2"), dx, scene.domain.min, options);
+    fluid::FluidSolver solver(scene.domain.cells, fluid_cells_along(scene, 1),
+                              fluid_cells_along(scene, 2), dx, scene.domain.min, options);
     apply_initial_velocity(scene.initial_velocity, solver.grid(), scene.cancel);
     // The velocity regions may have reached the box's faces.
     fluid::apply_boundary_velocity(solver.grid(), options.boundaries, solver.time());

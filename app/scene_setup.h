@@ -19,6 +19,13 @@ namespace meniscus::app {
 /// length before that refinement), else 0: measure it from the mesh.
 tracker::SurfaceMesh build_initial_surface(const Scene& scene, std::string* report = nullptr,
                                            double* nominal_xi = nullptr);
+/// Cells of the fluid grid along `axis`: /domain/cells along x, the /domain size over the cell
+/// size (rounded, at least 1) along y and z. Throws InputError past MAX_CELLS_PER_AXIS.
+int fluid_cells_along(const Scene& scene, int axis);
+/// The box a fluid scene's surface wraps around (issue 39): along each axis whose
+/// /fluid/boundaries are periodic, the grid's extent from /domain/min; none for other scenes.
+tracker::MeshPeriods scene_periods(const Scene& scene);
+
 /// The scene's tracker options with ξ set to `nominal_xi` unless the scene fixes it (or
 /// `nominal_xi` is 0).
 tracker::TrackerOptions tracker_options(const Scene& scene, double nominal_xi);

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -251,6 +252,44 @@ std::array<T, 3> sample_vertex(const fluid::MacGrid& grid, Eigen::Vector3d x, Ei
     return v;
 }
 
+/// Cells of copies added on each side of a periodic axis for sampling: more than any stencil
+/// here reaches beyond the point's cell (the one-sided columns reach two faces).
+constexpr int PERIODIC_PAD_CELLS = 4;
+
+/// A copy of `grid` grown by `pad` cells on both sides of each periodic axis, the added faces
+/// being the periodic images of the box's (face index I of the copy is face (I − pad) mod n of
+/// the box, the seam's copy at n left out). Its samplers need no knowledge of periods: a point of
+/// the box lies `pad` cells from the copy's ends along those axes.
+fluid::MacGrid padded_periodic_copy(const fluid::MacGrid& grid, int pad) {
+    std::array<int, 3> n{grid.nx(), grid.ny(), grid.nz()}, grown = n;
+    Eigen::Vector3d origin = grid.origin();
+    for (int a = 0; a < 3; ++a)
+        if (grid.periodic()[static_cast<size_t>(a)]) {
+            grown[static_cast<size_t>(a)] += 2 * pad;
+            origin[a] -= pad * grid.dx();
+        }
+    fluid::MacGrid copy(grown[0], grown[1], grown[2], grid.dx(), origin);
+    for (int axis = 0; axis < 3; ++axis) {
+        const fluid::Array3<double>& from = grid.velocity(axis);
+        fluid::Array3<double>& to = copy.velocity(axis);
+        const auto source = [&](int index, int a) {
+            if (!grid.periodic()[static_cast<size_t>(a)])
+                return index;
+            const int m = n[static_cast<size_t>(a)];
+            return ((index - pad) % m + m) % m;
+        };
+        for (int k = 0; k < to.nk(); ++k)
+            for (int j = 0; j < to.nj(); ++j)
+                for (int i = 0; i < to.ni(); ++i)
+                    to(i, j, k) = from(source(i, 0), source(j, 1), source(k, 2));
+    }
+    return copy;
+}
+
+bool any_periodic(const fluid::MacGrid& grid) {
+    return grid.periodic()[0] || grid.periodic()[1] || grid.periodic()[2];
+}
+
 }  // namespace
 
 void InterpolateOptions::validate() const {
@@ -276,6 +315,12 @@ std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& g
     walls.validate();
     std::vector<tracker::Vec3> velocities(static_cast<size_t>(mesh.num_vertices()),
                                           tracker::Vec3::Zero());
+    // A periodic box is sampled on a copy grown by its images (vertices of a periodic mesh lie
+    // in the box, so every stencil stays inside the copy).
+    std::optional<fluid::MacGrid> padded;
+    if (any_periodic(grid))
+        padded.emplace(padded_periodic_copy(grid, PERIODIC_PAD_CELLS));
+    const fluid::MacGrid& sampled = padded ? *padded : grid;
     const std::vector<tracker::Vec3> normals = options.method == VelocityInterpolation::one_sided
                                                    ? tracker::area_weighted_vertex_normals(mesh)
                                                    : std::vector<tracker::Vec3>{};
@@ -285,7 +330,7 @@ std::vector<tracker::Vec3> interpolate_vertex_velocities(const fluid::MacGrid& g
                 if (!mesh.vertex_alive(vi))
                     continue;
                 const std::array<double, 3> v = sample_vertex<double>(
-                    grid, mesh.position(vi),
+                    sampled, mesh.position(vi),
                     normals.empty() ? Eigen::Vector3d::Zero() : normals[static_cast<size_t>(vi)],
                     options, walls);
                 velocities[static_cast<size_t>(vi)] = tracker::Vec3(v[0], v[1], v[2]);
@@ -299,6 +344,10 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> vertex_velocity_weights(
     const InterpolateOptions& options, const fluid::BoundaryOptions& walls) {
     options.validate();
     walls.validate();
+    if (any_periodic(grid))
+        throw std::invalid_argument(
+            "vertex_velocity_weights: not available on a periodic grid (its forms would name the "
+            "faces of the box's images)");
     const std::vector<tracker::Vec3> normals = options.method == VelocityInterpolation::one_sided
                                                    ? tracker::area_weighted_vertex_normals(mesh)
                                                    : std::vector<tracker::Vec3>{};

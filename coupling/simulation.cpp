@@ -1,6 +1,7 @@
 #include "coupling/simulation.h"
 
 #include "coupling/implicit_tension.h"
+#include "coupling/periodic_images.h"
 #include "tracker/mesh_measures.h"
 
 #include <algorithm>
@@ -17,7 +18,38 @@ namespace {
 /// for mesh-scale wrinkles; a sliver's outsized cotangent weights must not throw a vertex far.
 constexpr double MAX_SUBGRID_STEP_EDGES = 0.25;
 
+const char* const AXIS_NAMES[3] = {"x", "y", "z"};
+
 }  // namespace
+
+void check_periods(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
+                   const fluid::BoundaryOptions& boundaries) {
+    const tracker::MeshPeriods& periods = mesh.periods();
+    for (int a = 0; a < 3; ++a) {
+        const std::string axis = AXIS_NAMES[a];
+        const bool box = grid.periodic()[static_cast<size_t>(a)];
+        if (box != periods.wraps(a))
+            throw std::invalid_argument(
+                box ? "periods: the fluid box is periodic along " + axis +
+                          " but the surface mesh does not wrap around it (SurfaceMesh::set_periods)"
+                    : "periods: the surface mesh wraps around " + axis +
+                          " but the fluid box is not periodic along it");
+        if (!box)
+            continue;
+        const double length = grid.dx() * grid.cells(a);
+        if (std::abs(periods.length[a] - length) > 1e-9 * length ||
+            std::abs(periods.origin[a] - grid.origin()[a]) > 1e-9 * length)
+            throw std::invalid_argument("periods: the surface mesh's period along " + axis +
+                                        " is not the fluid box's (origin and length must match)");
+    }
+    if (periods.any())
+        for (int a = 0; a < 3; ++a)
+            for (const fluid::BoundaryType type : {boundaries.at(a, 0), boundaries.at(a, 1)})
+                if (type == fluid::BoundaryType::inflow || type == fluid::BoundaryType::outflow)
+                    throw std::invalid_argument(
+                        "periods: inflow and outflow faces are not available together with "
+                        "periodic faces yet (the clipping and the nozzle's mesh do not wrap)");
+}
 
 void SimulationOptions::validate() const {
     rasterize.validate();
@@ -59,11 +91,11 @@ Simulation::Simulation(tracker::SurfaceTracker tracker, fluid::FluidSolver fluid
       m_fluid(std::move(fluid)),
       m_options(options) {
     m_options.validate();
-    const fluid::Periodicity& periodic = m_fluid.grid().periodic();
-    if (periodic[0] || periodic[1] || periodic[2])
+    check_periods(m_tracker->mesh(), m_fluid.grid(), m_fluid.options().boundaries);
+    if (m_tracker->mesh().periodic() && m_options.implicit_tension > 0.0)
         throw std::invalid_argument(
-            "Simulation: periodic faces are not available with a surface mesh yet (the mesh does "
-            "not wrap around the box; issue 39)");
+            "implicit_tension: not available with periodic faces (the surface viscosity does "
+            "not wrap around the box); use explicit surface tension (0)");
     if (m_options.volume_correction)
         m_volumes = std::make_unique<VolumeTracker>(m_tracker->mesh());
     m_vertex_velocities.assign(static_cast<size_t>(m_tracker->mesh().num_vertices()),
@@ -106,10 +138,17 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     // (2) Mesh → grid.
     SimulationTimings& timings = report.timings;
     PhaseClock clock;
-    RasterizeResult raster = rasterize_mesh(mesh, grid, m_options.rasterize);
+    // A periodic mesh is seen by the grid-side code unrolled: its images around the box, far
+    // enough out that the band, the curvature's smoothing rings and the seam faces see a whole
+    // surface (periodic_images.h).
+    UnrolledMesh unrolled;
+    if (mesh.periodic())
+        unrolled = unroll_periodic_mesh(mesh, unroll_margin(edges.mean));
+    const tracker::SurfaceMesh& grid_mesh = mesh.periodic() ? unrolled.mesh : mesh;
+    RasterizeResult raster = rasterize_mesh(grid_mesh, grid, m_options.rasterize);
     clock.lap_into(timings.rasterize);
     fluid::InterfaceInput interface;
-    face_curvatures(mesh, grid, raster, m_options.surface_tension, interface);
+    face_curvatures(grid_mesh, grid, raster, m_options.surface_tension, interface);
     interface.phi = std::move(raster.phi);
     if (m_options.implicit_tension > 0.0 && phases.sigma > 0.0)
         interface.surface_viscosity = build_surface_viscosity(
@@ -173,6 +212,15 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
         timings.total += *phase;
     m_time += report.integrate.time_advanced;
     return report;
+}
+
+double Simulation::unroll_margin(double mean_edge) const {
+    // The band, plus a ring per smoothing pass and per cotangent stencil, plus a cell for the
+    // seam faces' lo cells (half a cell beyond the box).
+    const double h = std::max(m_fluid.grid().dx(), mean_edge);
+    return (m_options.rasterize.half_width_cells + m_options.surface_tension.smoothing_passes +
+            4.0) *
+           h;
 }
 
 void Simulation::add_subgrid_tension(std::vector<tracker::Vec3>& velocities, double dt) const {

@@ -95,10 +95,19 @@ struct SimulationStepReport {
     SimulationTimings timings;
 };
 
-/// Owns the tracker and the fluid solver and steps them together.
+/// Periodic faces (issue 39): the surface mesh must wrap exactly where the fluid box is periodic
+/// (SurfaceMesh::set_periods with the box's origin and lengths along those axes), and inflow or
+/// outflow faces are not available with periodic ones yet. Throws std::invalid_argument naming
+/// the axis and the conflict.
+void check_periods(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
+                   const fluid::BoundaryOptions& boundaries);
+
+/// Owns the tracker and the fluid solver and steps them together. A periodic mesh is rasterized
+/// and its curvature taken on its images around the box (periodic_images.h); vertex velocities
+/// are sampled on the periodic grid.
 class Simulation {
 public:
-    /// Throws std::invalid_argument on bad options.
+    /// Throws std::invalid_argument on bad options or periods that do not match (check_periods).
     Simulation(tracker::SurfaceTracker tracker, fluid::FluidSolver fluid,
                const SimulationOptions& options);
 
@@ -132,6 +141,8 @@ private:
     /// Adds the sub-grid surface-tension velocity (subgrid_tension_velocities(), rate from
     /// options.surface_tension) to `velocities`, each capped at a quarter edge per `dt`.
     void add_subgrid_tension(std::vector<tracker::Vec3>& velocities, double dt) const;
+    /// How far beyond the box a periodic mesh is unrolled for the grid-side code (m).
+    double unroll_margin(double mean_edge) const;
 
     std::unique_ptr<tracker::SurfaceTracker> m_tracker;  // stable address for the observer
     fluid::FluidSolver m_fluid;

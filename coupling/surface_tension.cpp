@@ -58,7 +58,7 @@ double curvature_at_closest_point(const SurfaceMesh& mesh, const std::vector<dou
                                   const Vec3& x, double& distance) {
     const tracker::Triangle& t = mesh.triangle(ti);
     const tracker::PointTriangleProximity proximity = tracker::point_triangle_proximity(
-        x, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+        x, mesh.position_near(t[0], x), mesh.position_near(t[1], x), mesh.position_near(t[2], x));
     distance = proximity.distance;
     return proximity.barycentric[0] * kappa[static_cast<size_t>(t[0])] +
            proximity.barycentric[1] * kappa[static_cast<size_t>(t[1])] +
@@ -78,8 +78,8 @@ void remove_volume_change(const SurfaceMesh& mesh, std::vector<Vec3>& velocities
         if (!mesh.triangle_alive(ti))
             continue;
         const tracker::Triangle& t = mesh.triangle(ti);
-        const Vec3 area_vector = 0.5 * (mesh.position(t[1]) - mesh.position(t[0]))
-                                           .cross(mesh.position(t[2]) - mesh.position(t[0]));
+        const std::array<Vec3, 3> x = mesh.triangle_positions(ti);  // minimum image
+        const Vec3 area_vector = 0.5 * (x[1] - x[0]).cross(x[2] - x[0]);
         for (int vi : t) {
             gradient[static_cast<size_t>(vi)] += area_vector / 3.0;
             vertex_component[static_cast<size_t>(vi)] =
@@ -249,14 +249,24 @@ SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const flu
         const int di = axis == 0 ? 1 : 0;
         const int dj = axis == 1 ? 1 : 0;
         const int dk = axis == 2 ? 1 : 0;
-        // Only interior faces have two cells; slabs in k run in parallel.
+        // Only interior faces have two cells; slabs in k run in parallel. Along a periodic axis
+        // the face at index 0 is the seam between cell n − 1 (lo, at its image one period
+        // back, where the mesh — unrolled, periodic_images.h — has its triangles too) and cell 0;
+        // its copy at n is not visited (the fluid reads the seam at 0).
+        const int seam = grid.periodic()[static_cast<size_t>(axis)] && grid.cells(axis) > 1 ? 1 : 0;
+        const int n_axis = grid.cells(axis);
+        const int si = di * seam, sj = dj * seam, sk = dk * seam;
         tallies[static_cast<size_t>(axis)] = tbb::parallel_reduce(
-            tbb::blocked_range<int>(dk, face_kappa.nk() - dk), AxisTally(),
+            tbb::blocked_range<int>(dk - sk, face_kappa.nk() - dk), AxisTally(),
             [&](const tbb::blocked_range<int>& range, AxisTally tally) {
                 for (int k = range.begin(); k != range.end(); ++k)
-                    for (int j = dj; j < face_kappa.nj() - dj; ++j)
-                        for (int i = di; i < face_kappa.ni() - di; ++i) {
-                            const double phi_lo = raster.phi(i - di, j - dj, k - dk);
+                    for (int j = dj - sj; j < face_kappa.nj() - dj; ++j)
+                        for (int i = di - si; i < face_kappa.ni() - di; ++i) {
+                            const int along = axis == 0 ? i : (axis == 1 ? j : k);
+                            const int wrap = along == 0 ? n_axis : 0;  // lo cell across the seam
+                            const int li = i - di + di * wrap, lj = j - dj + dj * wrap,
+                                      lk = k - dk + dk * wrap;
+                            const double phi_lo = raster.phi(li, lj, lk);
                             const double phi_hi = raster.phi(i, j, k);
                             if (fluid::is_liquid(phi_lo) == fluid::is_liquid(phi_hi))
                                 continue;
@@ -267,7 +277,7 @@ SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const flu
                             const Vec3 x = x_lo + theta * (x_hi - x_lo);
                             double best = std::numeric_limits<double>::infinity();
                             double value = 0.0;
-                            for (int ti : {raster.closest_triangle(i - di, j - dj, k - dk),
+                            for (int ti : {raster.closest_triangle(li, lj, lk),
                                            raster.closest_triangle(i, j, k)}) {
                                 if (ti == tracker::INVALID_INDEX)
                                     continue;

@@ -3,6 +3,7 @@
 #include "tracker/mesh_measures.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <set>
@@ -164,8 +165,8 @@ double VolumeTracker::add_correction(std::vector<Vec3>& velocities, double dt,
         if (!m_mesh.triangle_alive(ti))
             continue;
         const tracker::Triangle& t = m_mesh.triangle(ti);
-        const Vec3 n2 = (m_mesh.position(t[1]) - m_mesh.position(t[0]))
-                            .cross(m_mesh.position(t[2]) - m_mesh.position(t[0]));
+        const std::array<Vec3, 3> x = m_mesh.triangle_positions(ti);  // minimum image
+        const Vec3 n2 = (x[1] - x[0]).cross(x[2] - x[0]);
         area[static_cast<size_t>(c.triangle_component[static_cast<size_t>(ti)])] += 0.5 * n2.norm();
         for (int v : t)
             normal[static_cast<size_t>(v)] += n2;  // area-weighted

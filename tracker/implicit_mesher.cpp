@@ -42,19 +42,33 @@ constexpr std::array<std::array<int, 4>, 6> KUHN_TETS = {
 
 class MarchingTetrahedra {
 public:
-    MarchingTetrahedra(const ImplicitShape& shape, double h, const CancellationToken& cancel)
-        : m_shape(shape), m_h(h), m_cancel(cancel) {
-        const Box3 b = shape.bounds();
+    /// Along an axis the periods wrap, the lattice covers one period with a whole number of
+    /// cells (spacing within h·(1 ± 1/n)) and its last cube joins the last node to node 0.
+    MarchingTetrahedra(const ImplicitShape& shape, double h, const MeshPeriods& periods,
+                       const CancellationToken& cancel)
+        : m_shape(shape), m_h(Vec3::Constant(h)), m_periods(periods), m_cancel(cancel) {
+        Box3 b = shape.bounds();
         if (b.isEmpty())
             throw std::runtime_error("shape has empty bounds");
+        for (int a = 0; a < 3; ++a)
+            if (periods.wraps(a)) {  // the shape may be unbounded along a wrapping axis
+                b.min()[a] = periods.origin[a];
+                b.max()[a] = periods.origin[a] + periods.length[a];
+            }
         if (!b.min().allFinite() || !b.max().allFinite())
             throw std::invalid_argument(
                 "shape is unbounded (e.g. a half-space): intersect it with a box");
         m_origin = b.min() - Vec3::Constant(PADDING_CELLS * h);
         // Counted in double first: a huge shape or a tiny h must not overflow the int counts.
         std::array<double, 3> n{};
-        for (int i = 0; i < 3; ++i)
+        for (int i = 0; i < 3; ++i) {
             n[i] = std::ceil(b.sizes()[i] / h) + 2 * PADDING_CELLS + 1;
+            if (periods.wraps(i)) {
+                n[i] = std::max(3.0, std::round(periods.length[i] / h));
+                m_h[i] = periods.length[i] / n[i];
+                m_origin[i] = periods.origin[i];
+            }
+        }
         const double nodes = n[0] * n[1] * n[2];
         if (!(nodes <= MAX_NODES) || !(h > 0.0)) {
             std::ostringstream s;
@@ -62,8 +76,10 @@ public:
               << std::setprecision(3) << nodes << " nodes, at most " << MAX_NODES << ")";
             throw std::invalid_argument(s.str());
         }
-        for (int i = 0; i < 3; ++i)
+        for (int i = 0; i < 3; ++i) {
             m_n[i] = static_cast<int>(n[i]);
+            m_cubes[i] = periods.wraps(i) ? m_n[i] : m_n[i] - 1;
+        }
         m_phi.resize(static_cast<size_t>(nodes));
         for (int k = 0; k < m_n[2]; ++k) {
             m_cancel.throw_if_requested("meshing the initial surface");
@@ -75,25 +91,62 @@ public:
                     m_phi[node_index(i, j, k)] = v;
                 }
         }
+        check_periodic();
     }
 
     SurfaceMesh build() {
-        for (int k = 0; k + 1 < m_n[2]; ++k) {
+        for (int k = 0; k < m_cubes[2]; ++k) {
             m_cancel.throw_if_requested("meshing the initial surface");
-            for (int j = 0; j + 1 < m_n[1]; ++j)
-                for (int i = 0; i + 1 < m_n[0]; ++i)
+            for (int j = 0; j < m_cubes[1]; ++j)
+                for (int i = 0; i < m_cubes[0]; ++i)
                     march_cube(i, j, k);
         }
-        return SurfaceMesh(std::move(m_positions), m_triangles);
+        SurfaceMesh mesh(std::move(m_positions), m_triangles);
+        if (m_periods.any())
+            mesh.set_periods(m_periods);
+        return mesh;
     }
 
 private:
     static constexpr double MAX_NODES = 2.0e8;
 
+    /// Node (i, j, k), an index n along a wrapping axis being node 0.
     size_t node_index(int i, int j, int k) const {
-        return (static_cast<size_t>(k) * m_n[1] + j) * m_n[0] + i;
+        const auto wrapped = [&](int v, int a) {
+            return v == m_n[a] && m_periods.wraps(a) ? 0 : v;
+        };
+        return (static_cast<size_t>(wrapped(k, 2)) * m_n[1] + wrapped(j, 1)) * m_n[0] +
+               wrapped(i, 0);
     }
-    Vec3 node_position(int i, int j, int k) const { return m_origin + m_h * Vec3(i, j, k); }
+    /// Node (i, j, k)'s position; index n along a wrapping axis is node 0's image one period on.
+    Vec3 node_position(int i, int j, int k) const {
+        return m_origin + m_h.cwiseProduct(Vec3(i, j, k));
+    }
+
+    /// A shape meshed on a periodic lattice must be periodic itself: φ one period on (at the
+    /// images of the nodes of the lattice's first plane) must have the sign it has there.
+    void check_periodic() const {
+        static const char* names[3] = {"x", "y", "z"};
+        for (int a = 0; a < 3; ++a) {
+            if (!m_periods.wraps(a))
+                continue;
+            const int b = (a + 1) % 3, c = (a + 2) % 3;
+            for (int q = 0; q < m_n[c]; ++q)
+                for (int r = 0; r < m_n[b]; ++r) {
+                    std::array<int, 3> idx{};
+                    idx[b] = r;
+                    idx[c] = q;
+                    const double here = m_phi[node_index(idx[0], idx[1], idx[2])];
+                    idx[a] = m_n[a];
+                    const double there = m_shape.value(node_position(idx[0], idx[1], idx[2]));
+                    if ((here < 0.0) != (there < 0.0))
+                        throw std::invalid_argument(
+                            std::string("periods: the shape is not periodic along ") + names[a] +
+                            ": it is inside at a point of one face of the box and outside at "
+                            "the same point of the opposite face");
+                }
+        }
+    }
 
     int crossing_vertex(size_t n0, const Vec3& p0, size_t n1, const Vec3& p1) {
         const std::uint64_t key =
@@ -121,13 +174,20 @@ private:
         }
         s = std::clamp(s, MIN_CROSSING_PARAMETER, 1.0 - MIN_CROSSING_PARAMETER);
         const int vi = static_cast<int>(m_positions.size());
-        m_positions.push_back(p0 + s * (p1 - p0));
+        m_positions.push_back(m_periods.any() ? m_periods.wrap(p0 + s * (p1 - p0))
+                                              : Vec3(p0 + s * (p1 - p0)));
         m_edge_vertex.emplace(key, vi);
         return vi;
     }
 
+    /// Crossing vertex vi's position at its image nearest `reference`.
+    Vec3 near(int vi, const Vec3& reference) const {
+        return m_periods.nearest_image(m_positions[static_cast<size_t>(vi)], reference);
+    }
+
     void emit(int a, int b, int c, const Vec3& inside_to_outside) {
-        const Vec3 n = (m_positions[b] - m_positions[a]).cross(m_positions[c] - m_positions[a]);
+        const Vec3& pa = m_positions[static_cast<size_t>(a)];
+        const Vec3 n = (near(b, pa) - pa).cross(near(c, pa) - pa);
         if (n.dot(inside_to_outside) >= 0.0)
             m_triangles.push_back({a, b, c});
         else
@@ -166,8 +226,9 @@ private:
                 // Two in, two out: a quad, split along its shorter diagonal.
                 const int a = cross(in[0], out[0]), b = cross(in[0], out[1]);
                 const int c = cross(in[1], out[1]), d = cross(in[1], out[0]);
-                if ((m_positions[a] - m_positions[c]).squaredNorm() <=
-                    (m_positions[b] - m_positions[d]).squaredNorm()) {
+                const Vec3& pa = m_positions[static_cast<size_t>(a)];
+                const Vec3& pb = m_positions[static_cast<size_t>(b)];
+                if ((pa - near(c, pa)).squaredNorm() <= (pb - near(d, pb)).squaredNorm()) {
                     emit(a, b, c, dir);
                     emit(a, c, d, dir);
                 } else {
@@ -179,10 +240,12 @@ private:
     }
 
     const ImplicitShape& m_shape;
-    double m_h;
+    Vec3 m_h;  // spacing per axis: h, or a period over a whole number of cells
+    MeshPeriods m_periods;
     CancellationToken m_cancel;
     Vec3 m_origin;
-    std::array<int, 3> m_n{};
+    std::array<int, 3> m_n{};      // nodes per axis
+    std::array<int, 3> m_cubes{};  // cubes per axis: m_n − 1, or m_n along a wrapping axis
     std::vector<double> m_phi;
     std::vector<Vec3> m_positions;
     std::vector<Triangle> m_triangles;
@@ -274,6 +337,16 @@ void ImplicitMeshOptions::validate() const {
     if (projection_iterations < 0)
         throw std::invalid_argument("projection_iterations: expected an integer >= 0");
     crease.validate();
+    periods.validate();
+    if (periods.any() && (crease.levels > 0 || crease.snap))
+        throw std::invalid_argument(
+            "crease: crease refinement and snapping are not available on periodic meshes");
+    for (int a = 0; a < 3; ++a)
+        if (periods.wraps(a) && periods.length[a] < MeshPeriods::PERIOD_TO_EDGE_RATIO * edge_length)
+            throw std::invalid_argument(
+                std::string("periods/length/") + "xyz"[a] + ": shorter than " +
+                std::to_string(static_cast<int>(MeshPeriods::PERIOD_TO_EDGE_RATIO)) +
+                " edge lengths (the minimum image of an element must be unambiguous)");
 }
 
 void CreaseRefinementOptions::validate() const {
@@ -306,7 +379,7 @@ Vec3 project_to_zero_set(const ImplicitShape& shape, const Vec3& x, int iteratio
 SurfaceMesh mesh_implicit_shape(const ImplicitShape& shape, const ImplicitMeshOptions& options,
                                 ImplicitMeshReport* report) {
     options.validate();
-    MarchingTetrahedra marching(shape, GRID_SPACING_FRACTION * options.edge_length,
+    MarchingTetrahedra marching(shape, GRID_SPACING_FRACTION * options.edge_length, options.periods,
                                 options.cancel);
     SurfaceMesh mesh = marching.build();
     if (mesh.count_live_triangles() == 0) {

@@ -42,6 +42,11 @@ struct ImplicitMeshOptions {
     int remesh_iterations = 8;      ///< isotropic remeshing iterations after marching tetrahedra
     int projection_iterations = 8;  ///< Newton steps onto φ = 0 per projected point
     CreaseRefinementOptions crease;
+    /// A periodic mesh (issue 39): along each axis that wraps, the lattice covers one period
+    /// and its last cells join its first, so the mesh closes across the box's faces (a column
+    /// running through the box becomes a closed tube). The shape must be periodic along those
+    /// axes (checked on the lattice). No crease refinement or snapping with periods.
+    MeshPeriods periods;
     /// Checked per grid slab and remeshing pass: throws meniscus::Cancelled once requested.
     CancellationToken cancel;
     void validate() const;          ///< throws std::invalid_argument naming the field

@@ -15,9 +15,17 @@ constexpr int MIN_VALENCE = 3;
 /// Relative slack on the Delaunay angle test, so co-circular quads do not flip back and forth.
 constexpr double DELAUNAY_SLACK = 1e-9;
 
+// Periodic meshes (periods.h): every stencil is read at the images nearest one of its points,
+// and every position computed here is wrapped back into the fundamental box before it is stored.
+
 Vec3 triangle_normal(const SurfaceMesh& mesh, const Triangle& t) {
-    return (mesh.position(t[1]) - mesh.position(t[0]))
-        .cross(mesh.position(t[2]) - mesh.position(t[0]));
+    const Vec3& a = mesh.position(t[0]);
+    return (mesh.position_near(t[1], a) - a).cross(mesh.position_near(t[2], a) - a);
+}
+
+/// p as the mesh stores it: wrapped into the fundamental box of a periodic mesh.
+Vec3 stored(const SurfaceMesh& mesh, const Vec3& p) {
+    return mesh.periodic() ? mesh.periods().wrap(p) : p;
 }
 
 int valence(const SurfaceMesh& mesh, int vi) {
@@ -51,11 +59,11 @@ public:
             if (!is_manifold_interior_edge(m_mesh, ei))
                 continue;
             const Edge e = m_mesh.edge(ei);
-            const Vec3 a = m_mesh.position(e[0]), b = m_mesh.position(e[1]);
+            const Vec3 a = m_mesh.position(e[0]), b = m_mesh.position_near(e[1], a);
             if ((b - a).norm() <= m_max_len)
                 continue;
-            const int vi = m_mesh.split_edge(ei, 0.5 * (a + b));
-            m_mesh.set_position(vi, m_project(0.5 * (a + b)));
+            const int vi = m_mesh.split_edge(ei, stored(m_mesh, 0.5 * (a + b)));
+            m_mesh.set_position(vi, stored(m_mesh, m_project(0.5 * (a + b))));
             ++n;
         }
         return n;
@@ -67,7 +75,8 @@ public:
             if (!is_manifold_interior_edge(m_mesh, ei))
                 continue;
             const Edge e = m_mesh.edge(ei);
-            if ((m_mesh.position(e[1]) - m_mesh.position(e[0])).norm() >= m_min_len)
+            const Vec3& a = m_mesh.position(e[0]);
+            if ((m_mesh.position_near(e[1], a) - a).norm() >= m_min_len)
                 continue;
             if (try_collapse(ei))
                 ++n;
@@ -92,6 +101,7 @@ public:
         for (int vi = 0; vi < m_mesh.num_vertices(); ++vi) {
             if (!m_mesh.vertex_alive(vi) || m_mesh.vertex_triangles(vi).empty())
                 continue;
+            const Vec3 p = m_mesh.position(vi);
             Vec3 normal = Vec3::Zero(), centroid = Vec3::Zero();
             double area = 0.0;
             for (int ti : m_mesh.vertex_triangles(vi)) {
@@ -99,17 +109,18 @@ public:
                 const Vec3 n = triangle_normal(m_mesh, t);
                 const double a = n.norm();
                 normal += n;
-                centroid +=
-                    a * (m_mesh.position(t[0]) + m_mesh.position(t[1]) + m_mesh.position(t[2])) /
-                    3.0;
+                centroid += a *
+                            (m_mesh.position_near(t[0], p) + m_mesh.position_near(t[1], p) +
+                             m_mesh.position_near(t[2], p)) /
+                            3.0;
                 area += a;
             }
             if (!(area > 0.0) || !(normal.norm() > 0.0))
                 continue;
             normal.normalize();
-            const Vec3 p = m_mesh.position(vi);
             const Vec3 d = centroid / area - p;
-            next[static_cast<size_t>(vi)] = m_project(p + d - normal * normal.dot(d));
+            next[static_cast<size_t>(vi)] =
+                stored(m_mesh, m_project(p + d - normal * normal.dot(d)));
         }
         m_mesh.set_positions(next);
     }
@@ -117,7 +128,7 @@ public:
     void project_all() {
         for (int vi = 0; vi < m_mesh.num_vertices(); ++vi)
             if (m_mesh.vertex_alive(vi))
-                m_mesh.set_position(vi, m_project(m_mesh.position(vi)));
+                m_mesh.set_position(vi, stored(m_mesh, m_project(m_mesh.position(vi))));
     }
 
 private:
@@ -135,7 +146,8 @@ private:
                 continue;  // deleted by the collapse
             std::array<Vec3, 3> p;
             for (int k = 0; k < 3; ++k)
-                p[k] = (t[k] == moved_a || t[k] == moved_b) ? new_pos : m_mesh.position(t[k]);
+                p[k] = (t[k] == moved_a || t[k] == moved_b) ? new_pos
+                                                            : m_mesh.position_near(t[k], new_pos);
             const Vec3 before = triangle_normal(m_mesh, t);
             const Vec3 after = (p[1] - p[0]).cross(p[2] - p[0]);
             const double nb = before.norm(), na = after.norm();
@@ -163,18 +175,20 @@ private:
             return false;
         if (valence(m_mesh, a) + valence(m_mesh, b) - 4 < MIN_VALENCE)
             return false;
-        const Vec3 target = m_project(0.5 * (m_mesh.position(a) + m_mesh.position(b)));
+        const Vec3& pa = m_mesh.position(a);
+        const Vec3 target = m_project(0.5 * (pa + m_mesh.position_near(b, pa)));
         // Do not create long edges.
         for (const std::vector<int>* ring : {&ra, &rb})
             for (int vj : *ring)
-                if (vj != a && vj != b && (m_mesh.position(vj) - target).norm() > m_max_len)
+                if (vj != a && vj != b &&
+                    (m_mesh.position_near(vj, target) - target).norm() > m_max_len)
                     return false;
         std::vector<int> affected = m_mesh.vertex_triangles(a);
         affected.insert(affected.end(), m_mesh.vertex_triangles(b).begin(),
                         m_mesh.vertex_triangles(b).end());
         if (!normals_stay_close(affected, a, b, target))
             return false;
-        m_mesh.collapse_edge(ei, a, target, 0.5);
+        m_mesh.collapse_edge(ei, a, stored(m_mesh, target), 0.5);
         return true;
     }
 
@@ -194,8 +208,8 @@ private:
             return false;
         if (valence(m_mesh, a) <= MIN_VALENCE || valence(m_mesh, b) <= MIN_VALENCE)
             return false;
-        const Vec3 pa = m_mesh.position(a), pb = m_mesh.position(b), pc = m_mesh.position(c),
-                   pd = m_mesh.position(d);
+        const Vec3 pa = m_mesh.position(a), pb = m_mesh.position_near(b, pa),
+                   pc = m_mesh.position_near(c, pa), pd = m_mesh.position_near(d, pa);
         // Delaunay criterion: flip when the angles opposite the edge sum to more than π.
         const auto angle = [](const Vec3& apex, const Vec3& p, const Vec3& q) {
             const Vec3 u = p - apex, v = q - apex;

@@ -19,8 +19,8 @@ Eigen::Vector3d MeshPeriods::wrap(const Eigen::Vector3d& p) const {
     Eigen::Vector3d q = p;
     for (int a = 0; a < 3; ++a)
         if (wraps(a)) {
-            q[a] = origin[a] + (p[a] - origin[a]) - length[a] * std::floor((p[a] - origin[a]) /
-                                                                             length[a]);
+            q[a] = origin[a] + (p[a] - origin[a]) -
+                   length[a] * std::floor((p[a] - origin[a]) / length[a]);
             // Rounding can land exactly on origin + length; that point is the origin's image.
             if (q[a] >= origin[a] + length[a])
                 q[a] = origin[a];

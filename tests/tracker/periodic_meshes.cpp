@@ -24,7 +24,9 @@ SurfaceMesh periodic_tube(double radius, const Vec3& centre, int axis, double le
             x.push_back(p);
         }
     }
-    const auto id = [&](int i, int j) { return ((j + along) % along) * around + (i + around) % around; };
+    const auto id = [&](int i, int j) {
+        return ((j + along) % along) * around + (i + around) % around;
+    };
     for (int j = 0; j < along; ++j)
         for (int i = 0; i < around; ++i) {
             // Odd rings are turned by half a step: ring j+1's vertex i sits between i and i+1 of

@@ -1,6 +1,8 @@
 // Periodic meshes (issue 39): the box a mesh wraps around and the minimum-image accessors.
 #include "periodic_meshes.h"
 
+#include "tracker/implicit_mesher.h"
+#include "tracker/implicit_shape.h"
 #include "tracker/mesh_validate.h"
 
 #include <gtest/gtest.h>
@@ -23,8 +25,8 @@ TEST(MeshPeriods, WrapAndNearestImage) {
     EXPECT_NEAR(n.x(), -1.1, 1e-15);
     EXPECT_EQ(n.y(), 3.0);
     EXPECT_NEAR(n.z(), -0.05, 1e-15);
-    EXPECT_NEAR(p.difference(Vec3(0.9, 0, 0.45), Vec3(-0.9, 0, 0.05)).norm(),
-                std::hypot(0.2, 0.1), 1e-15);
+    EXPECT_NEAR(p.difference(Vec3(0.9, 0, 0.45), Vec3(-0.9, 0, 0.05)).norm(), std::hypot(0.2, 0.1),
+                1e-15);
     // A point exactly on the upper face wraps to the origin's face.
     EXPECT_EQ(p.wrap(Vec3(1.0, 0.0, 0.5)).x(), -1.0);
     EXPECT_EQ(p.wrap(Vec3(1.0, 0.0, 0.5)).z(), 0.0);
@@ -84,11 +86,81 @@ TEST(PeriodicMesh, WrapPositionsAfterAMotionAcrossTheSeam) {
     }
 }
 
-TEST(PeriodicMesh, CopiesKeepThePeriodsAndLoadStateKeepsTheTargets) {
+TEST(PeriodicMesh, CopiesKeepThePeriods) {
     SurfaceMesh mesh = testing::periodic_tube(0.2, Vec3(0.5, 0.5, 0.0), 2, 1.0, 12, 10);
     SurfaceMesh copy = mesh;
     EXPECT_EQ(copy.periods(), mesh.periods());
     EXPECT_TRUE(copy.periodic());
+}
+
+/// A Rayleigh–Plateau column meshed on a lattice periodic along x: the mesh is a closed tube
+/// (a torus of the periodic box: χ = 0), every vertex on the perturbed radius, every element
+/// short by the minimum image, the vertices in the box.
+TEST(PeriodicMesh, ImplicitMesherClosesAColumnAcrossTheBox) {
+    const double length = 2.0, radius = 0.25, wavelength = 1.0, amplitude = 0.05, h = 0.06;
+    ShapePtr column = make_perturbed_cylinder(Vec3(1.0, 0.5, 0.5), Vec3::UnitX(), radius, 3.0,
+                                              amplitude, wavelength);
+    ImplicitMeshOptions options;
+    options.edge_length = h;
+    options.periods.length.x() = length;
+    const SurfaceMesh mesh = mesh_implicit_shape(*column, options);
+    ASSERT_TRUE(mesh.periodic());
+    EXPECT_TRUE(validate_mesh(mesh).empty());
+    int edges = 0, triangles = 0, vertices = 0;
+    double longest = 0.0, worst_radius = 0.0;
+    for (int e = 0; e < mesh.num_edges(); ++e) {
+        if (!mesh.edge_alive(e))
+            continue;
+        ++edges;
+        EXPECT_EQ(mesh.edge_triangles(e).size(), 2u);
+        const auto ends = mesh.edge_positions(e);
+        longest = std::max(longest, (ends[1] - ends[0]).norm());
+    }
+    for (int t = 0; t < mesh.num_triangles(); ++t)
+        triangles += mesh.triangle_alive(t) ? 1 : 0;
+    for (int v = 0; v < mesh.num_vertices(); ++v) {
+        if (!mesh.vertex_alive(v))
+            continue;
+        ++vertices;
+        const Vec3& p = mesh.position(v);
+        EXPECT_GE(p.x(), 0.0);
+        EXPECT_LT(p.x(), length);
+        const double r = std::hypot(p.y() - 0.5, p.z() - 0.5);
+        // The shape is centred at x = 1, so its cosine has a crest at x = 0 and x = 1.
+        const double expected = radius * (1.0 + amplitude * std::cos(2.0 * M_PI * (p.x() - 1.0)));
+        worst_radius = std::max(worst_radius, std::abs(r - expected));
+    }
+    EXPECT_EQ(vertices - edges + triangles, 0) << "a closed tube around a periodic axis is a torus";
+    EXPECT_LT(longest, 2.0 * h);
+    EXPECT_LT(worst_radius, 1e-3 * radius);
+    // Vertices lie on both sides of the seam: the tube was not cut there.
+    int near_low = 0, near_high = 0;
+    for (int v = 0; v < mesh.num_vertices(); ++v) {
+        near_low += mesh.position(v).x() < h ? 1 : 0;
+        near_high += mesh.position(v).x() > length - h ? 1 : 0;
+    }
+    EXPECT_GT(near_low, 0);
+    EXPECT_GT(near_high, 0);
+}
+
+TEST(PeriodicMesh, ImplicitMesherRefusesAShapeThatIsNotPeriodic) {
+    // A sphere inside the box touches neither face: fine. A column that is not periodic (its
+    // wavelength does not divide the period) is refused, naming the axis.
+    ImplicitMeshOptions options;
+    options.edge_length = 0.05;
+    options.periods.length.x() = 1.0;
+    EXPECT_NO_THROW(mesh_implicit_shape(*make_sphere(Vec3(0.5, 0.5, 0.5), 0.2), options));
+    ShapePtr cone = make_perturbed_cylinder(Vec3(0.3, 0.5, 0.5), Vec3::UnitX(), 0.2, 3.0, 0.5, 0.7);
+    try {
+        mesh_implicit_shape(*cone, options);
+        FAIL() << "a shape that does not repeat along x was meshed as periodic";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("not periodic along x"), std::string::npos)
+            << e.what();
+    }
+    options.periods.length.x() = 0.3;  // 6 edges: too short a period
+    EXPECT_THROW(mesh_implicit_shape(*make_sphere(Vec3(0.5, 0.5, 0.5), 0.1), options),
+                 std::invalid_argument);
 }
 
 }  // namespace
