@@ -7,9 +7,12 @@
 #include "remesh_test_meshes.h"
 
 #include "tracker/flows/mean_curvature.h"
+#include "tracker/intersection.h"
 #include "tracker/mesh_distance.h"
 #include "tracker/mesh_measures.h"
 #include "tracker/mesh_validate.h"
+#include "tracker/remesh/improve.h"
+#include "tracker/topology/change_topology.h"
 
 #include <gtest/gtest.h>
 
@@ -47,6 +50,72 @@ void translate(SurfaceMesh& mesh, const Vec3& shift) {
 
 double relative(double value, double reference) {
     return std::abs(value - reference) / std::abs(reference);
+}
+
+std::string violations_text(const std::vector<MeshViolation>& v) {
+    std::string s;
+    for (const MeshViolation& m : v)
+        s += m.message + "; ";
+    return s;
+}
+
+/// Triangle tj's corners at the image nearest triangle ti's first corner (the first corner's
+/// nearest image, the others nearest it: a coherent triangle even for a far pair).
+std::array<Vec3, 3> corners_near(const SurfaceMesh& mesh, int tj, const Vec3& reference) {
+    const Triangle& t = mesh.triangle(tj);
+    const Vec3 q0 = mesh.position_near(t[0], reference);
+    return {q0, mesh.position_near(t[1], q0), mesh.position_near(t[2], q0)};
+}
+
+/// Brute-force periodic intersection test (independent of the broad phase): every pair of live
+/// triangles, the second at its image nearest the first, by the exact shared-vertex-aware test.
+/// Returns the number of intersecting pairs.
+int periodic_intersections(const SurfaceMesh& mesh) {
+    int count = 0;
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti))
+            continue;
+        const std::array<Vec3, 3> p = mesh.triangle_positions(ti);
+        Eigen::AlignedBox3d box(p[0]);
+        box.extend(p[1]);
+        box.extend(p[2]);
+        for (int tj = ti + 1; tj < mesh.num_triangles(); ++tj) {
+            if (!mesh.triangle_alive(tj))
+                continue;
+            const std::array<Vec3, 3> q = corners_near(mesh, tj, p[0]);
+            Eigen::AlignedBox3d other(q[0]);
+            other.extend(q[1]);
+            other.extend(q[2]);
+            if (box.intersects(other) &&
+                triangles_intersect(p, mesh.triangle(ti), q, mesh.triangle(tj)))
+                ++count;
+        }
+    }
+    return count;
+}
+
+void expect_valid(const SurfaceMesh& mesh, const char* after) {
+    const auto violations = validate_mesh(mesh);
+    EXPECT_TRUE(violations.empty()) << after << ": " << violations_text(violations);
+    EXPECT_EQ(periodic_intersections(mesh), 0) << "intersects after " << after;
+}
+
+/// One mesh holding both meshes' vertices and triangles, with `periods`.
+SurfaceMesh combine(const SurfaceMesh& a, const SurfaceMesh& b, const MeshPeriods& periods) {
+    std::vector<Vec3> x = a.positions();
+    x.insert(x.end(), b.positions().begin(), b.positions().end());
+    std::vector<Triangle> t;
+    for (int ti = 0; ti < a.num_triangles(); ++ti)
+        t.push_back(a.triangle(ti));
+    for (int ti = 0; ti < b.num_triangles(); ++ti) {
+        Triangle tri = b.triangle(ti);
+        for (int& v : tri)
+            v += a.num_vertices();
+        t.push_back(tri);
+    }
+    SurfaceMesh mesh(std::move(x), t);
+    mesh.set_periods(periods);
+    return mesh;
 }
 
 // ---- measures --------------------------------------------------------------------------------
@@ -280,6 +349,175 @@ TEST(PeriodicDistance, DistanceToATubeIsTakenToItsNearestImage) {
     }
     // Outside, beside the seam.
     EXPECT_NEAR(distance.distance(Vec3(0.9999, 0.5, 0.5 + r + 0.1)), 0.1, 0.002);
+}
+
+// ---- merging ---------------------------------------------------------------------------------
+
+/// Two columns along z (period 1) side by side along x, in a box also periodic in x (period 1):
+/// radius 0.15, 16 × 20 vertices, placed on either side of x = `contact` (mod 1) with `gap`
+/// between them there and 0.4 − gap on the other side.
+SurfaceMesh two_columns(double gap, double contact) {
+    constexpr double R = 0.15;
+    MeshPeriods periods;
+    periods.length = Vec3(1.0, 0.0, 1.0);
+    const SurfaceMesh a =
+        testing::periodic_tube(R, Vec3(contact + R + 0.5 * gap, 0.5, 0.0), 2, 1.0, 16, 20);
+    const SurfaceMesh b =
+        testing::periodic_tube(R, Vec3(contact - R - 0.5 * gap, 0.5, 0.0), 2, 1.0, 16, 20);
+    return combine(a, b, periods);
+}
+
+TEST(PeriodicMerge, ColumnsTouchingAcrossTheSeamMergeIntoOneComponent) {
+    constexpr double GAP = 0.004;
+    // Contact across the seam x = 0 ≡ 1, and (the control) in the middle of the box.
+    for (const double contact : {0.0, 0.5}) {
+        SurfaceMesh mesh = two_columns(GAP, contact);
+        expect_valid(mesh, "generation");
+        ASSERT_EQ(triangle_components(mesh).count, 2);
+        ASSERT_EQ(euler_characteristic(mesh), 0);
+        const double volume = enclosed_volume(mesh);
+
+        TopologyOptions options;
+        TopologyContext context;
+        context.xi = testing::mean_edge_length(mesh);
+        ASSERT_LT(GAP, options.merge_distance_fraction * context.xi);
+        const TopologyReport report = change_topology(mesh, options, context);
+        EXPECT_GT(report.merge.candidates, 0) << "contact " << contact;
+        EXPECT_GE(report.merge.merges, 1) << "contact " << contact;
+        expect_valid(mesh, "merging");
+        // Across the seam, the band's triangles join vertices a period apart in raw coordinates
+        // (before the merge no triangle did: each column lies inside the box).
+        int across = 0;
+        for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+            if (!mesh.triangle_alive(ti))
+                continue;
+            const Triangle& t = mesh.triangle(ti);
+            const double x0 = mesh.position(t[0]).x();
+            across += std::abs(mesh.position(t[1]).x() - x0) > 0.5 ||
+                              std::abs(mesh.position(t[2]).x() - x0) > 0.5
+                          ? 1
+                          : 0;
+        }
+        EXPECT_EQ(across > 0, contact == 0.0) << across << " triangles across the x seam";
+        EXPECT_EQ(triangle_components(mesh).count, 1) << "contact " << contact;
+        // Each merge opens one handle between the columns: χ drops by 2 per merge.
+        EXPECT_EQ(euler_characteristic(mesh), -2 * report.merge.merges);
+        // The band bridges a gap of 0.004 over a few edges: a tiny volume change.
+        EXPECT_LT(relative(enclosed_volume(mesh), volume), 1e-3)
+            << enclosed_volume(mesh) << " vs " << volume;
+        // The merged neck is where the columns met: within a few edges of x = contact.
+        for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+            if (mesh.triangle_alive(ti) && mesh.triangle_marked(ti)) {
+                const Vec3 c = mesh.triangle_positions(ti)[0];
+                const double dx = mesh.periods().difference(c, Vec3(contact, 0.0, 0.0)).x();
+                EXPECT_LT(std::abs(dx), 0.1) << "a new triangle at x = " << c.x();
+            }
+
+        // Remeshing afterwards keeps one valid component.
+        RemeshOptions remesh;
+        ImproveContext improve;
+        improve.xi = context.xi;
+        improve_mesh(mesh, remesh, improve);
+        expect_valid(mesh, "improvement after merging");
+        EXPECT_EQ(triangle_components(mesh).count, 1);
+    }
+}
+
+TEST(PeriodicMerge, FarColumnsDoNotMerge) {
+    SurfaceMesh mesh = two_columns(0.05, 0.0);  // 0.05 apart across the seam: beyond 0.1 ξ
+    TopologyContext context;
+    context.xi = testing::mean_edge_length(mesh);
+    const TopologyReport report = change_topology(mesh, TopologyOptions{}, context);
+    EXPECT_EQ(report.merge.candidates, 0);
+    EXPECT_EQ(triangle_components(mesh).count, 2);
+}
+
+// ---- separation --------------------------------------------------------------------------------
+
+TEST(PeriodicSeparation, SingularVertexOnTheSeamIsSplitTowardsItsFansNearestImages) {
+    // Two tetrahedra sharing vertex 0 at x = 0 ≡ 1: one on each side of the seam, so that one
+    // fan's other vertices lie a period away in raw coordinates.
+    const double s = 0.1;
+    std::vector<Vec3> p = {{0, 0.5, 0.5},     {s, 0.5, 0.5},       {0, 0.5 + s, 0.5},
+                           {0, 0.5, 0.5 + s}, {1.0 - s, 0.5, 0.5}, {0, 0.5 - s, 0.5},
+                           {0, 0.5, 0.5 - s}};
+    std::vector<Triangle> t = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3},
+                               {0, 4, 5}, {0, 6, 4}, {0, 5, 6}, {4, 6, 5}};
+    SurfaceMesh mesh(p, t);
+    MeshPeriods periods;
+    periods.length = Vec3(1.0, 0.0, 0.0);
+    mesh.set_periods(periods);
+    expect_valid(mesh, "generation");
+    const Vec3 x0 = mesh.position(0);
+    const SeparationOptions options;
+    const SeparationReport r = separate(mesh, options, true, 0.5);
+    EXPECT_EQ(r.singular_vertices_split, 1);
+    EXPECT_EQ(r.copies_created, 1);
+    EXPECT_EQ(vertex_fans(mesh, 0).size(), 1u);
+    expect_valid(mesh, "separation");
+    EXPECT_EQ(triangle_components(mesh).count, 2);
+    // Each copy moved by nudge_fraction × the distance to its fan's centroid (about s / 2), in
+    // the box; read by raw coordinates the seam-side fan's centroid would be half a box away.
+    for (const int v : {0, mesh.num_vertices() - 1}) {
+        const Vec3 x = mesh.position(v);
+        EXPECT_GE(x.x(), 0.0);
+        EXPECT_LT(x.x(), 1.0);
+        const double moved = mesh.periods().difference(x, x0).norm();
+        EXPECT_GT(moved, 0.0);
+        EXPECT_LT(moved, options.nudge_fraction * s) << "vertex " << v;
+    }
+    // Both pieces keep their volume (the nudge moves a vertex inside its own tetrahedron's
+    // fan: a change of order nudge_fraction).
+    const std::vector<double> v = component_volumes(mesh, triangle_components(mesh));
+    for (double vol : v)
+        EXPECT_NEAR(vol, s * s * s / 6.0, 0.05 * s * s * s / 6.0);
+}
+
+TEST(PeriodicSeparation, ColumnPinchedAtTheSeamBecomesOneClosedDrop) {
+    // A column whose radius narrows towards z = 0 ≡ 1; squeezing the waist further (about the
+    // seam) while remeshing and changing topology pinches it: the periodic column (a torus in
+    // the box, χ = 0) becomes one closed drop (χ = 2).
+    constexpr double R = 0.15;
+    const auto waist = [](double z) {
+        const double d = std::min(z, 1.0 - z);  // distance to the seam
+        return 1.0 - 0.5 * std::exp(-(d / 0.12) * (d / 0.12));
+    };
+    SurfaceMesh mesh = testing::periodic_tube(R, Vec3(0.5, 0.5, 0.0), 2, 1.0, 24, 40, waist);
+    expect_valid(mesh, "generation");
+    RemeshOptions remesh;
+    ImproveContext improve;
+    improve.xi = testing::mean_edge_length(mesh);
+    TopologyOptions topology;
+    TopologyContext topo_context;
+    topo_context.xi = improve.xi;
+    constexpr int MAX_STEPS = 60;
+    int steps = 0;
+    while ((triangle_components(mesh).count != 1 || euler_characteristic(mesh) != 2) &&
+           steps < MAX_STEPS) {
+        for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+            if (!mesh.vertex_alive(vi))
+                continue;
+            Vec3 x = mesh.position(vi);
+            const double d = std::min(x.z(), 1.0 - x.z());
+            const double f = 1.0 - 0.15 * std::exp(-(d / 0.1) * (d / 0.1));
+            x.x() = 0.5 + f * (x.x() - 0.5);
+            x.y() = 0.5 + f * (x.y() - 0.5);
+            mesh.set_position(vi, x);
+        }
+        ASSERT_EQ(periodic_intersections(mesh), 0) << "the squeeze itself intersected";
+        improve_mesh(mesh, remesh, improve);
+        expect_valid(mesh, "improvement");
+        change_topology(mesh, topology, topo_context);
+        expect_valid(mesh, "topology change");
+        ++steps;
+    }
+    mesh.compact();
+    EXPECT_EQ(triangle_components(mesh).count, 1) << "after " << steps << " steps";
+    EXPECT_EQ(euler_characteristic(mesh), 2) << "after " << steps << " steps";
+    EXPECT_GT(enclosed_volume(mesh), 0.0);
+    // The drop no longer wraps: every vertex's z is away from the seam it pinched at.
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi)
+        EXPECT_GT(std::min(mesh.position(vi).z(), 1.0 - mesh.position(vi).z()), 0.0);
 }
 
 }  // namespace
