@@ -325,6 +325,18 @@ TEST(PeriodicCurvature, TubeCurvatureIsTheSameAtEveryVertexSeamRingsIncluded) {
         mean_curvature_displacements(mesh, 1e-4, MeanCurvatureIntegrator::heun);
     for (int vi = 0; vi < mesh.num_vertices(); ++vi)
         EXPECT_NEAR(heun[static_cast<size_t>(vi)].norm(), heun[0].norm(), 1e-12);
+    // The quartic fit over two-rings (surface_fit, by minimum image): the same at the seam rings
+    // and closer to 1/r than the cotangent formula.
+    int fallbacks = -1;
+    const std::vector<Vec3> fitted = fitted_mean_curvature_normals(mesh, 1.0, nullptr, &fallbacks);
+    EXPECT_EQ(fallbacks, 0);
+    for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
+        const size_t i = static_cast<size_t>(vi);
+        const Vec3 radial =
+            (mesh.position(vi) - Vec3(0.5, 0.5, mesh.position(vi).z())).normalized();
+        EXPECT_LT((fitted[i] - fitted[i].norm() * radial).norm(), 1e-6) << "vertex " << vi;
+        EXPECT_LT(relative(fitted[i].norm(), 1.0 / r), 1.5e-3) << "vertex " << vi;
+    }
 }
 
 TEST(PeriodicCurvature, FlatSheetHasNoCurvature) {
