@@ -73,6 +73,148 @@ Box3d triangle_box(const std::vector<Vec3>& x_t0, const std::vector<Vec3>& x_t1,
     return swept_box({&x_t0[a], &x_t0[b], &x_t0[c]}, {&x_t1[a], &x_t1[b], &x_t1[c]}, padding);
 }
 
+// ---- periodic meshes (issue 39) -----------------------------------------------------------
+
+/// Extra padding of a periodic mesh's boxes, in units of the largest coordinate of the box the
+/// mesh wraps around: the pairs' shifts and the images' shifts are sums of whole periods and
+/// coordinates, rounded differently; this covers that rounding (~10⁻¹⁴ of the box).
+constexpr double PERIODIC_ROUNDING_PADDING = 64.0 * std::numeric_limits<double>::epsilon();
+
+double periodic_padding(const MeshPeriods& periods, double padding) {
+    const double scale = (periods.origin.cwiseAbs() + periods.length).maxCoeff();
+    return padding + PERIODIC_ROUNDING_PADDING * scale;
+}
+
+/// The whole-period shift that moves p into the fundamental box (0 when it lies there already,
+/// and along axes that do not wrap).
+Vec3 into_box(const MeshPeriods& periods, const Vec3& p) {
+    Vec3 s = Vec3::Zero();
+    for (int a = 0; a < 3; ++a)
+        if (periods.wraps(a)) {
+            const double u = p[a] - periods.origin[a];
+            if (u < 0.0 || u >= periods.length[a])
+                s[a] = -periods.length[a] * std::floor(u / periods.length[a]);
+        }
+    return s;
+}
+
+/// Box of the element with corners `v` swept x_t0 → x_t1 on a periodic mesh: every corner at
+/// its image nearest the first corner at t0 (the same shift at t0 and t1), the whole element
+/// moved by whole periods so that its first corner at t0 lies in the fundamental box.
+template <size_t N>
+Box3d periodic_box(const MeshPeriods& periods, const std::vector<Vec3>& x_t0,
+                   const std::vector<Vec3>& x_t1, const std::array<int, N>& v, double padding) {
+    const Vec3& first = x_t0[static_cast<size_t>(v[0])];
+    const Vec3 base = into_box(periods, first);
+    Box3d b;
+    for (size_t k = 0; k < N; ++k) {
+        const auto i = static_cast<size_t>(v[k]);
+        const Vec3 s = k == 0 ? base : Vec3(periods.shift_towards(x_t0[i], first) + base);
+        b.extend(Vec3(x_t0[i] + s));
+        b.extend(Vec3(x_t1[i] + s));
+    }
+    b.min().array() -= padding;
+    b.max().array() += padding;
+    return b;
+}
+
+Box3d shifted(const Box3d& b, const Vec3& s) {
+    return Box3d(Vec3(b.min() + s), Vec3(b.max() + s));
+}
+
+/// The whole-period shifts of the images of `box` that can overlap another element's box
+/// (excluding 0): along each wrapping axis, +length when the box lies within `reach` of the
+/// low face, −length when within `reach` of the high face; every combination over the axes.
+void image_shifts(const MeshPeriods& periods, const Vec3& reach, const Box3d& box,
+                  std::vector<Vec3>& out) {
+    out.clear();
+    out.push_back(Vec3::Zero());
+    for (int a = 0; a < 3; ++a) {
+        if (!periods.wraps(a))
+            continue;
+        const double lo = periods.origin[a], hi = lo + periods.length[a];
+        const bool near_low = box.min()[a] <= lo + reach[a];
+        const bool near_high = box.max()[a] >= hi - reach[a];
+        const size_t count = out.size();
+        for (const double sign : {1.0, -1.0}) {
+            if (sign > 0.0 ? !near_low : !near_high)
+                continue;
+            for (size_t k = 0; k < count; ++k) {
+                Vec3 s = out[k];
+                s[a] = sign * periods.length[a];
+                out.push_back(s);
+            }
+        }
+    }
+    out.erase(out.begin());  // the element itself
+}
+
+/// Appends to `boxes` (one per element) the images image_shifts() gives, and to `image_of` the
+/// element of each.
+void append_images(const MeshPeriods& periods, const Vec3& reach, std::vector<Box3d>& boxes,
+                   std::vector<int>& image_of) {
+    const size_t n = boxes.size();
+    std::vector<Vec3> shifts;
+    for (size_t i = 0; i < n; ++i) {
+        if (boxes[i].isEmpty())
+            continue;
+        image_shifts(periods, reach, boxes[i], shifts);
+        for (const Vec3& s : shifts) {
+            boxes.push_back(shifted(boxes[i], s));
+            image_of.push_back(static_cast<int>(i));
+        }
+    }
+}
+
+/// reach ← per axis the larger of reach and the extents of the non-empty boxes.
+void extend_reach(const std::vector<Box3d>& boxes, Vec3& reach) {
+    for (const Box3d& b : boxes)
+        if (!b.isEmpty())
+            reach = reach.cwiseMax(b.sizes());
+}
+
+/// The 3^k whole-period shifts (k wrapping axes), the zero shift first.
+std::vector<Vec3> all_shifts(const MeshPeriods& periods) {
+    std::vector<Vec3> out{Vec3::Zero()};
+    for (int a = 0; a < 3; ++a) {
+        if (!periods.wraps(a))
+            continue;
+        const size_t count = out.size();
+        for (const double sign : {1.0, -1.0})
+            for (size_t k = 0; k < count; ++k) {
+                Vec3 s = out[k];
+                s[a] = sign * periods.length[a];
+                out.push_back(s);
+            }
+    }
+    return out;
+}
+
+/// Box of element `v` as BroadPhase builds it (periodic or not).
+template <size_t N>
+Box3d element_box(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
+                  const std::vector<Vec3>& x_t1, const std::array<int, N>& v, double padding) {
+    if (mesh.periodic())
+        return periodic_box(mesh.periods(), x_t0, x_t1, v,
+                            periodic_padding(mesh.periods(), padding));
+    Box3d b;
+    for (size_t k = 0; k < N; ++k) {
+        b.extend(x_t0[static_cast<size_t>(v[k])]);
+        b.extend(x_t1[static_cast<size_t>(v[k])]);
+    }
+    b.min().array() -= padding;
+    b.max().array() += padding;
+    return b;
+}
+
+/// True when `a` overlaps `b` or one of b's images (`shifts` from all_shifts()).
+bool overlaps_some_image(const Box3d& a, const Box3d& b, const std::vector<Vec3>& shifts) {
+    for (const Vec3& s : shifts)
+        if (overlaps(a, shifted(b, s)))
+            return true;
+    return false;
+}
+
 }  // namespace
 
 Box3d swept_box(std::initializer_list<const Vec3*> p_t0, std::initializer_list<const Vec3*> p_t1,
@@ -608,34 +750,72 @@ BroadPhase::BroadPhase(const SurfaceMesh& mesh, double padding)
 
 BroadPhase::BroadPhase(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0,
                        const std::vector<Vec3>& x_t1, double padding)
-    : m_mesh(mesh),
-      m_vertex_boxes((check_sizes(mesh, x_t0, x_t1, padding),
-                      boxes_of(mesh.num_vertices(),
-                               [&](int vi, Box3d& b) {
-                                   if (mesh.vertex_alive(vi) && !mesh.vertex_triangles(vi).empty())
-                                       b = vertex_box(x_t0, x_t1, vi, padding);
-                               }))),
-      m_edge_boxes(boxes_of(mesh.num_edges(),
-                            [&](int ei, Box3d& b) {
-                                if (mesh.edge_alive(ei))
-                                    b = edge_box(x_t0, x_t1, mesh.edge(ei), padding);
-                            })),
-      m_triangle_boxes(boxes_of(mesh.num_triangles(),
-                                [&](int ti, Box3d& b) {
-                                    if (mesh.triangle_alive(ti))
-                                        b = triangle_box(x_t0, x_t1, mesh.triangle(ti), padding);
-                                })),
-      m_edges(m_edge_boxes),
-      m_triangles(m_triangle_boxes) {}
+    : m_mesh(mesh), m_num_edges(mesh.num_edges()), m_num_triangles(mesh.num_triangles()) {
+    check_sizes(mesh, x_t0, x_t1, padding);
+    if (!mesh.periodic()) {
+        m_vertex_boxes = boxes_of(mesh.num_vertices(), [&](int vi, Box3d& b) {
+            if (mesh.vertex_alive(vi) && !mesh.vertex_triangles(vi).empty())
+                b = vertex_box(x_t0, x_t1, vi, padding);
+        });
+        m_edge_boxes = boxes_of(mesh.num_edges(), [&](int ei, Box3d& b) {
+            if (mesh.edge_alive(ei))
+                b = edge_box(x_t0, x_t1, mesh.edge(ei), padding);
+        });
+        m_triangle_boxes = boxes_of(mesh.num_triangles(), [&](int ti, Box3d& b) {
+            if (mesh.triangle_alive(ti))
+                b = triangle_box(x_t0, x_t1, mesh.triangle(ti), padding);
+        });
+    } else {
+        m_vertex_boxes = boxes_of(mesh.num_vertices(), [&](int vi, Box3d& b) {
+            if (mesh.vertex_alive(vi) && !mesh.vertex_triangles(vi).empty())
+                b = element_box(mesh, x_t0, x_t1, std::array<int, 1>{vi}, padding);
+        });
+        m_edge_boxes = boxes_of(mesh.num_edges(), [&](int ei, Box3d& b) {
+            if (mesh.edge_alive(ei))
+                b = element_box(mesh, x_t0, x_t1, mesh.edge(ei), padding);
+        });
+        m_triangle_boxes = boxes_of(mesh.num_triangles(), [&](int ti, Box3d& b) {
+            if (mesh.triangle_alive(ti))
+                b = element_box(mesh, x_t0, x_t1, mesh.triangle(ti), padding);
+        });
+        Vec3 reach = Vec3::Zero();
+        extend_reach(m_vertex_boxes, reach);
+        extend_reach(m_edge_boxes, reach);
+        extend_reach(m_triangle_boxes, reach);
+        append_images(mesh.periods(), reach, m_edge_boxes, m_edge_image_of);
+        append_images(mesh.periods(), reach, m_triangle_boxes, m_triangle_image_of);
+    }
+    m_edges.emplace(m_edge_boxes);
+    m_triangles.emplace(m_triangle_boxes);
+}
 
 std::vector<VertexTrianglePair> BroadPhase::vertex_triangle_pairs() const {
+    if (!m_mesh.periodic())
+        return collect_parallel<VertexTrianglePair>(
+            m_vertex_boxes.size(),
+            [&](int vi, std::vector<int>& scratch, std::vector<VertexTrianglePair>& out) {
+                const Box3d& vb = m_vertex_boxes[static_cast<size_t>(vi)];
+                if (vb.isEmpty())
+                    return;
+                m_triangles->query(vb, scratch);
+                for (int ti : scratch) {
+                    const Triangle& t = m_mesh.triangle(ti);
+                    if (t[0] != vi && t[1] != vi && t[2] != vi)
+                        out.push_back({vi, ti});
+                }
+            });
+    // Periodic: the ids found are triangles or their images; each triangle once per vertex.
     return collect_parallel<VertexTrianglePair>(
         m_vertex_boxes.size(),
         [&](int vi, std::vector<int>& scratch, std::vector<VertexTrianglePair>& out) {
             const Box3d& vb = m_vertex_boxes[static_cast<size_t>(vi)];
             if (vb.isEmpty())
                 return;
-            m_triangles.query(vb, scratch);
+            m_triangles->query(vb, scratch);
+            for (int& id : scratch)
+                id = triangle_of(id);
+            std::sort(scratch.begin(), scratch.end());
+            scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
             for (int ti : scratch) {
                 const Triangle& t = m_mesh.triangle(ti);
                 if (t[0] != vi && t[1] != vi && t[2] != vi)
@@ -644,33 +824,92 @@ std::vector<VertexTrianglePair> BroadPhase::vertex_triangle_pairs() const {
         });
 }
 
+namespace {
+
+template <typename Pair>
+void deduplicate(std::vector<Pair>& sorted) {
+    sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+}
+
+}  // namespace
+
 std::vector<EdgeEdgePair> BroadPhase::edge_edge_pairs() const {
-    return self_join<EdgeEdgePair>(m_edges, [&](int ei, int ej, std::vector<EdgeEdgePair>& out) {
-        if (!shares_vertex(m_mesh.edge(ei), m_mesh.edge(ej)))
-            out.push_back({std::min(ei, ej), std::max(ei, ej)});
-    });
+    if (!m_mesh.periodic())
+        return self_join<EdgeEdgePair>(*m_edges,
+                                       [&](int ei, int ej, std::vector<EdgeEdgePair>& out) {
+                                           if (!shares_vertex(m_mesh.edge(ei), m_mesh.edge(ej)))
+                                               out.push_back({std::min(ei, ej), std::max(ei, ej)});
+                                       });
+    // Periodic: an element against the images of the others (two images overlap only where
+    // their elements do, which is found without them); an edge never pairs with its own image.
+    std::vector<EdgeEdgePair> pairs =
+        self_join<EdgeEdgePair>(*m_edges, [&](int i, int j, std::vector<EdgeEdgePair>& out) {
+            if (i >= m_num_edges && j >= m_num_edges)
+                return;
+            const int ei = edge_of(i), ej = edge_of(j);
+            if (ei != ej && !shares_vertex(m_mesh.edge(ei), m_mesh.edge(ej)))
+                out.push_back({std::min(ei, ej), std::max(ei, ej)});
+        });
+    deduplicate(pairs);
+    return pairs;
 }
 
 std::vector<TrianglePair> BroadPhase::triangle_pairs() const {
-    return self_join<TrianglePair>(m_triangles, [](int ti, int tj, std::vector<TrianglePair>& out) {
-        out.push_back({std::min(ti, tj), std::max(ti, tj)});
-    });
+    if (!m_mesh.periodic())
+        return self_join<TrianglePair>(*m_triangles,
+                                       [](int ti, int tj, std::vector<TrianglePair>& out) {
+                                           out.push_back({std::min(ti, tj), std::max(ti, tj)});
+                                       });
+    std::vector<TrianglePair> pairs =
+        self_join<TrianglePair>(*m_triangles, [&](int i, int j, std::vector<TrianglePair>& out) {
+            if (i >= m_num_triangles && j >= m_num_triangles)
+                return;
+            const int ti = triangle_of(i), tj = triangle_of(j);
+            if (ti != tj)
+                out.push_back({std::min(ti, tj), std::max(ti, tj)});
+        });
+    deduplicate(pairs);
+    return pairs;
 }
 
 std::vector<EdgeEdgePair> static_edge_edge_pairs(const SurfaceMesh& mesh, double padding,
                                                  const std::function<bool(int, int)>& keep) {
     const std::vector<Vec3>& x = mesh.positions();
     check_sizes(mesh, x, x, padding);
-    const std::vector<Box3d> boxes = boxes_of(mesh.num_edges(), [&](int ei, Box3d& b) {
+    if (!mesh.periodic()) {
+        const std::vector<Box3d> boxes = boxes_of(mesh.num_edges(), [&](int ei, Box3d& b) {
+            if (mesh.edge_alive(ei))
+                b = edge_box(x, x, mesh.edge(ei), padding);
+        });
+        const LooseGrid grid(boxes);
+        return self_join<EdgeEdgePair>(grid, [&](int ei, int ej, std::vector<EdgeEdgePair>& out) {
+            const int a = std::min(ei, ej), b = std::max(ei, ej);
+            if (!shares_vertex(mesh.edge(a), mesh.edge(b)) && keep(a, b))
+                out.push_back({a, b});
+        });
+    }
+    std::vector<Box3d> boxes = boxes_of(mesh.num_edges(), [&](int ei, Box3d& b) {
         if (mesh.edge_alive(ei))
-            b = edge_box(x, x, mesh.edge(ei), padding);
+            b = element_box(mesh, x, x, mesh.edge(ei), padding);
     });
+    Vec3 reach = Vec3::Zero();
+    extend_reach(boxes, reach);
+    std::vector<int> image_of;
+    const int n = mesh.num_edges();
+    append_images(mesh.periods(), reach, boxes, image_of);
     const LooseGrid grid(boxes);
-    return self_join<EdgeEdgePair>(grid, [&](int ei, int ej, std::vector<EdgeEdgePair>& out) {
-        const int a = std::min(ei, ej), b = std::max(ei, ej);
-        if (!shares_vertex(mesh.edge(a), mesh.edge(b)) && keep(a, b))
-            out.push_back({a, b});
-    });
+    std::vector<EdgeEdgePair> pairs =
+        self_join<EdgeEdgePair>(grid, [&](int i, int j, std::vector<EdgeEdgePair>& out) {
+            if (i >= n && j >= n)
+                return;
+            const int ei = i < n ? i : image_of[static_cast<size_t>(i - n)];
+            const int ej = j < n ? j : image_of[static_cast<size_t>(j - n)];
+            const int a = std::min(ei, ej), b = std::max(ei, ej);
+            if (a != b && !shares_vertex(mesh.edge(a), mesh.edge(b)) && keep(a, b))
+                out.push_back({a, b});
+        });
+    deduplicate(pairs);
+    return pairs;
 }
 
 std::vector<VertexTrianglePair> brute_force_vertex_triangle_pairs(const SurfaceMesh& mesh,
@@ -678,18 +917,21 @@ std::vector<VertexTrianglePair> brute_force_vertex_triangle_pairs(const SurfaceM
                                                                   const std::vector<Vec3>& x_t1,
                                                                   double padding) {
     check_sizes(mesh, x_t0, x_t1, padding);
+    const std::vector<Vec3> shifts = all_shifts(mesh.periods());
     std::vector<VertexTrianglePair> out;
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
         if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty())
             continue;
-        const Box3d vb = vertex_box(x_t0, x_t1, vi, padding);
+        const Box3d vb = mesh.periodic()
+                             ? element_box(mesh, x_t0, x_t1, std::array<int, 1>{vi}, padding)
+                             : vertex_box(x_t0, x_t1, vi, padding);
         for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
             if (!mesh.triangle_alive(ti))
                 continue;
             const Triangle& t = mesh.triangle(ti);
             if (t[0] == vi || t[1] == vi || t[2] == vi)
                 continue;
-            if (overlaps(vb, triangle_box(x_t0, x_t1, t, padding)))
+            if (overlaps_some_image(vb, element_box(mesh, x_t0, x_t1, t, padding), shifts))
                 out.push_back({vi, ti});
         }
     }
@@ -701,17 +943,36 @@ std::vector<EdgeEdgePair> brute_force_edge_edge_pairs(const SurfaceMesh& mesh,
                                                       const std::vector<Vec3>& x_t1,
                                                       double padding) {
     check_sizes(mesh, x_t0, x_t1, padding);
+    const std::vector<Vec3> shifts = all_shifts(mesh.periods());
     std::vector<EdgeEdgePair> out;
     for (int ei = 0; ei < mesh.num_edges(); ++ei) {
         if (!mesh.edge_alive(ei))
             continue;
-        const Box3d a = edge_box(x_t0, x_t1, mesh.edge(ei), padding);
+        const Box3d a = element_box(mesh, x_t0, x_t1, mesh.edge(ei), padding);
         for (int ej = ei + 1; ej < mesh.num_edges(); ++ej) {
             if (!mesh.edge_alive(ej) || shares_vertex(mesh.edge(ei), mesh.edge(ej)))
                 continue;
-            if (overlaps(a, edge_box(x_t0, x_t1, mesh.edge(ej), padding)))
+            if (overlaps_some_image(a, element_box(mesh, x_t0, x_t1, mesh.edge(ej), padding),
+                                    shifts))
                 out.push_back({ei, ej});
         }
+    }
+    return out;
+}
+
+std::vector<TrianglePair> brute_force_triangle_pairs(const SurfaceMesh& mesh, double padding) {
+    const std::vector<Vec3>& x = mesh.positions();
+    check_sizes(mesh, x, x, padding);
+    const std::vector<Vec3> shifts = all_shifts(mesh.periods());
+    std::vector<TrianglePair> out;
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+        if (!mesh.triangle_alive(ti))
+            continue;
+        const Box3d a = element_box(mesh, x, x, mesh.triangle(ti), padding);
+        for (int tj = ti + 1; tj < mesh.num_triangles(); ++tj)
+            if (mesh.triangle_alive(tj) &&
+                overlaps_some_image(a, element_box(mesh, x, x, mesh.triangle(tj), padding), shifts))
+                out.push_back({ti, tj});
     }
     return out;
 }

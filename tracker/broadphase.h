@@ -10,6 +10,19 @@
 /// `BroadPhase` holds one hash per element type (vertices, edges, triangles) for a mesh whose
 /// vertices move linearly from x_t0 to x_t1 (swept boxes; static when x_t0 = x_t1) and
 /// enumerates candidate pairs for CCD, proximity and intersection tests.
+///
+/// Periodic meshes (periods.h, issue 39): an element's box is built from its corners at their
+/// images nearest its first corner at t0 (the same shift at t0 and at t1), the whole element
+/// moved by whole periods so that that first corner lies in the fundamental box. A box within
+/// E of a face of the fundamental box along a wrapping axis (E: the largest box extent along
+/// that axis, padding included) is also stored at its image(s) shifted by ∓ the period (every
+/// combination for two or three wrapping axes), so elements that meet across the box's faces
+/// are paired. Pairs are reported once, by element index, never an element with its own image;
+/// the caller reads each pair by the minimum image: the second element's vertices at their
+/// images nearest the first element's first vertex at t0 (MeshPeriods::shift_towards), the
+/// same shift at t0 and t1. The result equals the periodic brute force below (every pair
+/// against the 3^k images of its second element). Non-periodic meshes take the path they
+/// always took (one branch).
 
 #include "tracker/mesh.h"
 
@@ -17,6 +30,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 namespace meniscus::tracker {
@@ -175,9 +189,23 @@ public:
     std::vector<TrianglePair> triangle_pairs() const;
 
 private:
+    /// Element of entry `id` of m_edge_boxes / m_triangle_boxes (an image maps to its element).
+    int edge_of(int id) const {
+        return id < m_num_edges ? id : m_edge_image_of[static_cast<size_t>(id - m_num_edges)];
+    }
+    int triangle_of(int id) const {
+        return id < m_num_triangles
+                   ? id
+                   : m_triangle_image_of[static_cast<size_t>(id - m_num_triangles)];
+    }
+
     const SurfaceMesh& m_mesh;
+    // Boxes by element index; for a periodic mesh the images follow: entry num_edges() + k is
+    // an image of edge m_edge_image_of[k] (likewise for triangles).
     std::vector<Box3d> m_vertex_boxes, m_edge_boxes, m_triangle_boxes;
-    LooseGrid m_edges, m_triangles;
+    std::vector<int> m_edge_image_of, m_triangle_image_of;
+    int m_num_edges = 0, m_num_triangles = 0;
+    std::optional<LooseGrid> m_edges, m_triangles;  // built in the constructor's body
 };
 
 /// Edge–edge pairs of the mesh at rest (no shared vertex, ei < ej, sorted) whose boxes, padded
@@ -185,6 +213,11 @@ private:
 /// candidate at once (merging): only edge boxes are built, and the test runs inside the
 /// parallel join instead of on a list of every overlapping pair. `keep` may be called from
 /// several threads at once. Throws std::invalid_argument on negative padding.
+///
+/// Periodic meshes: the boxes' images are paired as in BroadPhase; `keep` gets element indices
+/// and must read the pair by the minimum image itself (ej's ends at their images nearest ei's
+/// first end: mesh.position_near(v, mesh.position(mesh.edge(ei)[0]))). It may then be called
+/// more than once for the same pair (found through two images); each pair is returned once.
 std::vector<EdgeEdgePair> static_edge_edge_pairs(const SurfaceMesh& mesh, double padding,
                                                  const std::function<bool(int, int)>& keep);
 
@@ -192,7 +225,9 @@ std::vector<EdgeEdgePair> static_edge_edge_pairs(const SurfaceMesh& mesh, double
 Box3d swept_box(std::initializer_list<const Vec3*> p_t0, std::initializer_list<const Vec3*> p_t1,
                 double padding);
 
-/// Brute-force references (O(n²)) for tests: the same pairs the broad phase must include.
+/// Brute-force references (O(n²)) for tests: the same pairs the broad phase must include. For a
+/// periodic mesh, each pair's first element's box against the boxes of the 3^k images of the
+/// second (k wrapping axes; boxes as BroadPhase builds them).
 std::vector<VertexTrianglePair> brute_force_vertex_triangle_pairs(const SurfaceMesh& mesh,
                                                                   const std::vector<Vec3>& x_t0,
                                                                   const std::vector<Vec3>& x_t1,
@@ -201,5 +236,7 @@ std::vector<EdgeEdgePair> brute_force_edge_edge_pairs(const SurfaceMesh& mesh,
                                                       const std::vector<Vec3>& x_t0,
                                                       const std::vector<Vec3>& x_t1,
                                                       double padding);
+/// Triangle pairs (ti < tj) whose static boxes at the mesh's positions, padded, overlap.
+std::vector<TrianglePair> brute_force_triangle_pairs(const SurfaceMesh& mesh, double padding);
 
 }  // namespace meniscus::tracker

@@ -14,8 +14,11 @@ MeshDistance::MeshDistance(const SurfaceMesh& mesh) {
         if (!mesh.triangle_alive(ti))
             continue;
         const Triangle& t = mesh.triangle(ti);
-        const std::array<Vec3, 3> c = {mesh.position(t[0]), mesh.position(t[1]),
-                                       mesh.position(t[2])};
+        // A periodic mesh's triangle at the image of its first corner (in the box).
+        const std::array<Vec3, 3> c =
+            mesh.periodic() ? mesh.triangle_positions(ti)
+                            : std::array<Vec3, 3>{mesh.position(t[0]), mesh.position(t[1]),
+                                                  mesh.position(t[2])};
         Box3d box(c[0]);
         box.extend(c[1]);
         box.extend(c[2]);
@@ -32,12 +35,42 @@ MeshDistance::MeshDistance(const SurfaceMesh& mesh) {
     if (!(m_initial_half_width > 0.0))
         m_initial_half_width = 1.0;  // every triangle is one point
     m_grid = std::make_unique<LooseGrid>(m_boxes);
+    m_periods = mesh.periods();
 }
 
 double MeshDistance::distance(const Vec3& p) const {
+    if (!m_periods.any())
+        return distance_to_stored(p, std::numeric_limits<double>::infinity());
+    // Each triangle is stored at the image whose first corner lies in the box, and p is taken
+    // into the box: along a wrapping axis they are less than a period (plus an edge) apart, so
+    // the nearest image of any triangle is one of the stored triangles seen from p shifted by
+    // −1, 0 or +1 period along each wrapping axis.
+    const Vec3 q = m_periods.wrap(p);
+    double best = distance_to_stored(q, std::numeric_limits<double>::infinity());
+    std::array<int, 3> k{};
+    for (k[0] = -1; k[0] <= 1; ++k[0])
+        for (k[1] = -1; k[1] <= 1; ++k[1])
+            for (k[2] = -1; k[2] <= 1; ++k[2]) {
+                Vec3 shift = Vec3::Zero();
+                bool moved = false, skip = false;
+                for (int a = 0; a < 3; ++a) {
+                    skip = skip || (k[static_cast<size_t>(a)] != 0 && !m_periods.wraps(a));
+                    moved = moved || k[static_cast<size_t>(a)] != 0;
+                    shift[a] = k[static_cast<size_t>(a)] * m_periods.length[a];
+                }
+                if (skip || !moved)
+                    continue;
+                const Vec3 image = q + shift;
+                // The distance to the triangles' bounding box bounds this image's from below.
+                if (m_bounds.exteriorDistance(image) < best)
+                    best = distance_to_stored(image, best);
+            }
+    return best;
+}
+
+double MeshDistance::distance_to_stored(const Vec3& p, double best) const {
     std::vector<int> ids;
     double half_width = m_initial_half_width;
-    double best = std::numeric_limits<double>::infinity();
     for (;;) {
         const Box3d query(p - Vec3::Constant(half_width), p + Vec3::Constant(half_width));
         m_grid->query(query, ids);

@@ -65,9 +65,11 @@ void check_triangles(const SurfaceMesh& mesh, const ValidationOptions& options, 
                     describe_triangle(mesh, ti) + " has the same vertices as triangle " +
                         std::to_string(it->second));
         if (options.check_degenerate_area) {
+            // A periodic mesh's triangle is read by the minimum image (its raw corners may lie
+            // a period apart).
             const Vec3& a = mesh.position(t[0]);
-            const Vec3& b = mesh.position(t[1]);
-            const Vec3& c = mesh.position(t[2]);
+            const Vec3 b = mesh.position_near(t[1], a);
+            const Vec3 c = mesh.position_near(t[2], a);
             const double twice_area = (b - a).cross(c - a).norm();
             const double longest_sq =
                 std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});

@@ -2,6 +2,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <array>
+
 namespace meniscus::tracker {
 
 Eigen::Matrix3d VertexQuadric::null_space_projector() const {
@@ -24,9 +26,9 @@ VertexQuadric vertex_quadric(const SurfaceMesh& mesh, int vi, const FeatureThres
     Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
     double total_weight = 0.0;
     for (int ti : mesh.vertex_triangles(vi)) {
-        const Triangle& t = mesh.triangle(ti);
-        const Vec3 n = (mesh.position(t[1]) - mesh.position(t[0]))
-                           .cross(mesh.position(t[2]) - mesh.position(t[0]));
+        // Periodic meshes: corners at the minimum image of the first (normals need no more).
+        const std::array<Vec3, 3> p = mesh.triangle_positions(ti);
+        const Vec3 n = (p[1] - p[0]).cross(p[2] - p[0]);
         const double twice_area = n.norm();
         if (!(twice_area > 0.0))
             continue;

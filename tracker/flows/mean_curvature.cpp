@@ -36,7 +36,15 @@ CotangentSums accumulate(const SurfaceMesh& mesh, const Position& position) {
         if (!mesh.triangle_alive(ti))
             continue;
         const Triangle& t = mesh.triangle(ti);
-        const std::array<Vec3, 3> p = {position(t[0]), position(t[1]), position(t[2])};
+        std::array<Vec3, 3> p = {position(t[0]), position(t[1]), position(t[2])};
+        if (mesh.periodic()) {
+            // The minimum image about the first corner: every quantity below (edge vectors,
+            // cotangents, areas) is translation invariant, so each vertex's sum over its one-ring
+            // is the one of the one-ring unwrapped about it. `position` may be unwrapped
+            // (Heun's predictor), hence the periods rather than position_near().
+            p[1] = mesh.periods().nearest_image(p[1], p[0]);
+            p[2] = mesh.periods().nearest_image(p[2], p[0]);
+        }
         const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
         std::array<double, 3> cot{};
         int obtuse_corner = -1;
@@ -125,43 +133,43 @@ std::vector<double> mean_curvatures(const SurfaceMesh& mesh) {
 }
 
 std::vector<Vec3> fitted_mean_curvature_normals(const SurfaceMesh& mesh, double max_turn,
-                                                const std::vector<Vec3>* positions,
-                                                int* fallbacks, bool sphere_refit) {
+                                                const std::vector<Vec3>* positions, int* fallbacks,
+                                                bool sphere_refit) {
     if (!(max_turn > 0.0))
         throw std::invalid_argument("max_turn: expected a number > 0 (radians), got " +
                                     std::to_string(max_turn));
     if (positions && positions->size() != static_cast<size_t>(mesh.num_vertices()))
         throw std::invalid_argument("positions: expected one per vertex slot");
     std::vector<Vec3> k =
-        positions ? curvature_normals(mesh, accumulate(mesh,
-                                                       [positions](int v) -> const Vec3& {
-                                                           return (*positions)[static_cast<size_t>(v)];
-                                                       }))
-                  : mean_curvature_normals(mesh);
+        positions
+            ? curvature_normals(mesh, accumulate(mesh,
+                                                 [positions](int v) -> const Vec3& {
+                                                     return (*positions)[static_cast<size_t>(v)];
+                                                 }))
+            : mean_curvature_normals(mesh);
     SurfaceFitOptions fit;
     fit.degree = QUARTIC_DEGREE;
     fit.through_origin = true;  // the vertex is on the surface; its curvature is wanted
     fit.sphere_refit = sphere_refit;
     std::atomic<int> cotangent{0};
-    tbb::parallel_for(tbb::blocked_range<int>(0, mesh.num_vertices(), FIT_GRAIN),
-                      [&](const tbb::blocked_range<int>& range) {
-                          int local = 0;
-                          for (int vi = range.begin(); vi < range.end(); ++vi) {
-                              if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty() ||
-                                  mesh.is_boundary_vertex(vi))
-                                  continue;
-                              const std::optional<SurfacePatch> patch =
-                                  positions ? vertex_patch(mesh, *positions, vi, fit)
-                                            : vertex_patch(mesh, vi, fit);
-                              if (patch && patch->degree >= CUBIC_DEGREE &&
-                                  patch->turn() <= max_turn)
-                                  k[static_cast<size_t>(vi)] =
-                                      patch->mean_curvature() * patch->surface_normal();
-                              else
-                                  ++local;
-                          }
-                          cotangent += local;
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, mesh.num_vertices(), FIT_GRAIN),
+        [&](const tbb::blocked_range<int>& range) {
+            int local = 0;
+            for (int vi = range.begin(); vi < range.end(); ++vi) {
+                if (!mesh.vertex_alive(vi) || mesh.vertex_triangles(vi).empty() ||
+                    mesh.is_boundary_vertex(vi))
+                    continue;
+                const std::optional<SurfacePatch> patch =
+                    positions ? vertex_patch(mesh, *positions, vi, fit)
+                              : vertex_patch(mesh, vi, fit);
+                if (patch && patch->degree >= CUBIC_DEGREE && patch->turn() <= max_turn)
+                    k[static_cast<size_t>(vi)] = patch->mean_curvature() * patch->surface_normal();
+                else
+                    ++local;
+            }
+            cotangent += local;
+        });
     if (fallbacks)
         *fallbacks = cotangent;
     return k;

@@ -15,6 +15,10 @@ namespace meniscus::tracker {
 std::optional<Vec3> butterfly_point(const SurfaceMesh& mesh, int ei);
 
 /// Midpoint of edge `ei`.
+///
+/// On a periodic mesh both points are computed at the minimum image of the edge's first vertex
+/// (the whole stencil unwrapped around it) and returned there, not wrapped: callers wrap a
+/// point before storing it as a vertex position.
 Vec3 edge_midpoint(const SurfaceMesh& mesh, int ei);
 
 }  // namespace meniscus::tracker

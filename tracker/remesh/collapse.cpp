@@ -7,6 +7,7 @@
 #include "tracker/remesh/surface_fit.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -23,9 +24,10 @@ constexpr double PI = 3.14159265358979323846;
 /// degenerate (validate_mesh's default tolerance).
 constexpr double DEGENERATE_AREA_FRACTION = 1e-12;
 
+/// Length of edge ei (by the minimum image on a periodic mesh).
 double edge_length(const SurfaceMesh& mesh, int ei) {
-    const Edge& e = mesh.edge(ei);
-    return (mesh.position(e[0]) - mesh.position(e[1])).norm();
+    const std::array<Vec3, 2> p = mesh.edge_positions(ei);
+    return (p[0] - p[1]).norm();
 }
 
 void sort_unique(std::vector<int>& v) {
@@ -54,14 +56,21 @@ bool contains(const Triangle& t, int vi) {
     return t[0] == vi || t[1] == vi || t[2] == vi;
 }
 
+/// Position of vi before the collapse. On a periodic mesh every vertex a collapse looks at is
+/// read at its image nearest the kept vertex (the one reference of the operation), where
+/// plan.position also is.
+Vec3 before(const SurfaceMesh& mesh, const CollapsePlan& plan, int vi) {
+    return mesh.position_near(vi, mesh.position(plan.kept));
+}
+
 /// Position of vi after the collapse.
-const Vec3& moved(const SurfaceMesh& mesh, const CollapsePlan& plan, int vi) {
-    return vi == plan.kept || vi == plan.removed ? plan.position : mesh.position(vi);
+Vec3 moved(const SurfaceMesh& mesh, const CollapsePlan& plan, int vi) {
+    return vi == plan.kept || vi == plan.removed ? plan.position : before(mesh, plan, vi);
 }
 
 /// Parameter of `position` along the edge from kept to removed, clamped to [0, 1].
 double edge_parameter(const SurfaceMesh& mesh, const CollapsePlan& plan) {
-    const Vec3 d = mesh.position(plan.removed) - mesh.position(plan.kept);
+    const Vec3 d = before(mesh, plan, plan.removed) - mesh.position(plan.kept);
     const double length2 = d.squaredNorm();
     if (!(length2 > 0.0))
         return 0.0;
@@ -80,7 +89,7 @@ CollapsePlan volume_preserving(const SurfaceMesh& mesh, CollapsePlan plan) {
     if (!(g2 > 0.0))
         return plan;
     const Vec3 correction = -collapse_volume_change(mesh, plan) / g2 * g;
-    const double length = (mesh.position(plan.kept) - mesh.position(plan.removed)).norm();
+    const double length = (mesh.position(plan.kept) - before(mesh, plan, plan.removed)).norm();
     if (correction.norm() <= MAX_VOLUME_CORRECTION_FRACTION * length)
         plan.position += correction;
     return plan;
@@ -157,6 +166,8 @@ PlanCandidates plan_collapse(const SurfaceMesh& mesh, int ei, const RemeshOption
         preferred = edge_midpoint(mesh, ei);
     }
     const Vec3 midpoint = edge_midpoint(mesh, ei);
+    // Periodic meshes: both points are at the minimum image of e[0] (butterfly.h,
+    // surface_fit.h), which is base.kept here.
     const int n = options.collapse_position_attempts;
     for (int k = 0; k < n; ++k) {
         const double w = n == 1 ? 0.0 : static_cast<double>(k) / (n - 1);
@@ -224,9 +235,10 @@ bool collapse_inverts_normal(const SurfaceMesh& mesh, const CollapsePlan& plan,
         const Triangle& t = mesh.triangle(ti);
         if (contains(t, plan.kept) && contains(t, plan.removed))
             continue;  // deleted by the collapse
-        const Vec3 &p0 = mesh.position(t[0]), &p1 = mesh.position(t[1]), &p2 = mesh.position(t[2]);
-        const Vec3 &q0 = moved(mesh, plan, t[0]), &q1 = moved(mesh, plan, t[1]),
-                   &q2 = moved(mesh, plan, t[2]);
+        const Vec3 p0 = before(mesh, plan, t[0]), p1 = before(mesh, plan, t[1]),
+                   p2 = before(mesh, plan, t[2]);
+        const Vec3 q0 = moved(mesh, plan, t[0]), q1 = moved(mesh, plan, t[1]),
+                   q2 = moved(mesh, plan, t[2]);
         const Vec3 n_before = (p1 - p0).cross(p2 - p0);
         const Vec3 n_after = (q1 - q0).cross(q2 - q0);
         const double longest =
@@ -246,8 +258,8 @@ double collapse_volume_change(const SurfaceMesh& mesh, const CollapsePlan& plan)
     double six_change = 0.0;
     for (int ti : star_triangles(mesh, plan)) {
         const Triangle& t = mesh.triangle(ti);
-        const Vec3 p0 = mesh.position(t[0]) - origin, p1 = mesh.position(t[1]) - origin,
-                   p2 = mesh.position(t[2]) - origin;
+        const Vec3 p0 = before(mesh, plan, t[0]) - origin, p1 = before(mesh, plan, t[1]) - origin,
+                   p2 = before(mesh, plan, t[2]) - origin;
         six_change -= p0.dot(p1.cross(p2));
         if (contains(t, plan.kept) && contains(t, plan.removed))
             continue;
@@ -269,8 +281,8 @@ Vec3 collapse_volume_gradient(const SurfaceMesh& mesh, const CollapsePlan& plan)
             continue;
         for (int k = 0; k < 3; ++k)
             if (t[k] == plan.kept || t[k] == plan.removed) {
-                six_gradient += (mesh.position(t[(k + 1) % 3]) - origin)
-                                    .cross(mesh.position(t[(k + 2) % 3]) - origin);
+                six_gradient += (before(mesh, plan, t[(k + 1) % 3]) - origin)
+                                    .cross(before(mesh, plan, t[(k + 2) % 3]) - origin);
                 break;
             }
     }
@@ -288,7 +300,7 @@ bool collapse_creates_long_edge(const SurfaceMesh& mesh, const CollapsePlan& pla
             const int n = mesh.other_vertex(ei, vi);
             if (n == plan.kept || n == plan.removed)
                 continue;
-            const double after = (plan.position - mesh.position(n)).norm();
+            const double after = (plan.position - before(mesh, plan, n)).norm();
             if (after > alpha && after > edge_length(mesh, ei))
                 return true;
         }
@@ -308,7 +320,6 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
                                     const ImproveContext& context) {
     const auto start = std::chrono::steady_clock::now();
     CollapseReport report;
-    const RemeshLimits limits = remesh_limits(options, context.xi);
     // Built on the first collision check (a pass with nothing to do never pays for it), then
     // kept current through every mutation.
     std::unique_ptr<ElementHash> hash;
@@ -321,6 +332,9 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
     // β (and the α no new edge may exceed) per edge, lower where the surface turns or faces
     // itself with adaptive sizing; measured once per call (a collapse keeps one endpoint).
     const EdgeSizing sizing(mesh, options, context.xi);
+    // α and β as sizing.h sets them (on a periodic mesh at most the smallest period over
+    // MeshPeriods::PERIOD_TO_EDGE_RATIO); remesh_limits() otherwise.
+    const RemeshLimits& limits = sizing.limits();
     // Vertices of the stars the last pass's collapses changed. Every check of a collapse reads
     // only the stars of the edge's endpoints (and, for collisions, what is near them), so a
     // short edge refused in one pass is tried again in the next only when an endpoint's star
@@ -422,7 +436,9 @@ CollapseReport collapse_short_edges(SurfaceMesh& mesh, const RemeshOptions& opti
                 changed[static_cast<size_t>(vi)] = 1;
             if (hash)
                 hash->begin_update(mesh, touched);
-            mesh.collapse_edge(ei, plan.kept, plan.position, edge_parameter(mesh, plan));
+            // plan.position is at the minimum image of the kept vertex: stored wrapped.
+            mesh.collapse_edge(ei, plan.kept, mesh.periods().wrap(plan.position),
+                               edge_parameter(mesh, plan));
             if (hash)
                 hash->refresh(mesh, touched);
             ++report.collapses;

@@ -36,6 +36,16 @@ bool degenerate(const Vec3& a, const Vec3& b, const Vec3& c) {
     return normal_of(a, b, c).norm() <= DEGENERATE_AREA_FRACTION * longest;
 }
 
+/// The stencil's four vertices; on a periodic mesh at their images nearest a (the minimum image,
+/// one reference for the whole stencil).
+struct StencilPositions {
+    Vec3 a, b, c, d;
+};
+StencilPositions positions_of(const SurfaceMesh& mesh, const FlipStencil& s) {
+    const Vec3& a = mesh.position(s.a);
+    return {a, mesh.position_near(s.b, a), mesh.position_near(s.c, a), mesh.position_near(s.d, a)};
+}
+
 FlipStencil make_stencil(const SurfaceMesh& mesh, int ei, int t_forward, int t_backward) {
     FlipStencil s;
     s.ei = ei;
@@ -64,7 +74,8 @@ bool best_stencil(const SurfaceMesh& mesh, int ei, const RemeshOptions& options,
             const FlipStencil s = make_stencil(mesh, ei, tf, tb);
             if (s.c == s.d || !flip_improves(mesh, s, options))
                 continue;
-            const double length = (mesh.position(s.c) - mesh.position(s.d)).norm();
+            const StencilPositions p = positions_of(mesh, s);
+            const double length = (p.c - p.d).norm();
             if (!found || length < best_length) {
                 best = s;
                 best_length = length;
@@ -78,8 +89,7 @@ bool best_stencil(const SurfaceMesh& mesh, int ei, const RemeshOptions& options,
 }  // namespace
 
 bool flip_improves(const SurfaceMesh& mesh, const FlipStencil& s, const RemeshOptions& options) {
-    const Vec3 &a = mesh.position(s.a), &b = mesh.position(s.b);
-    const Vec3 &c = mesh.position(s.c), &d = mesh.position(s.d);
+    const auto [a, b, c, d] = positions_of(mesh, s);
     const double old_length = (a - b).norm();
     const double new_length = (c - d).norm();
     if (!(new_length < (1.0 - options.min_flip_length_decrease_fraction) * old_length))
@@ -90,9 +100,9 @@ bool flip_improves(const SurfaceMesh& mesh, const FlipStencil& s, const RemeshOp
 }
 
 double flip_fold_angle(const SurfaceMesh& mesh, const FlipStencil& s) {
-    const Vec3 &a = mesh.position(s.a), &b = mesh.position(s.b);
-    const Vec3 n0 = normal_of(a, b, mesh.position(s.c));
-    const Vec3 n1 = normal_of(b, a, mesh.position(s.d));
+    const auto [a, b, c, d] = positions_of(mesh, s);
+    const Vec3 n0 = normal_of(a, b, c);
+    const Vec3 n1 = normal_of(b, a, d);
     return std::atan2(n0.cross(n1).norm(), n0.dot(n1));
 }
 
@@ -101,16 +111,14 @@ bool flip_creates_existing_edge(const SurfaceMesh& mesh, const FlipStencil& s) {
 }
 
 bool flip_changes_volume_too_much(const SurfaceMesh& mesh, const FlipStencil& s, double gamma) {
-    const Vec3& a = mesh.position(s.a);
-    const double six_volume =
-        (mesh.position(s.b) - a).dot((mesh.position(s.c) - a).cross(mesh.position(s.d) - a));
+    const auto [a, b, c, d] = positions_of(mesh, s);
+    const double six_volume = (b - a).dot((c - a).cross(d - a));
     return std::abs(six_volume) / 6.0 > gamma;
 }
 
 bool flip_changes_normals_too_much(const SurfaceMesh& mesh, const FlipStencil& s,
                                    const RemeshOptions& options) {
-    const Vec3 &a = mesh.position(s.a), &b = mesh.position(s.b);
-    const Vec3 &c = mesh.position(s.c), &d = mesh.position(s.d);
+    const auto [a, b, c, d] = positions_of(mesh, s);
     if (degenerate(c, a, d) || degenerate(d, b, c))
         return true;
     const double min_cos = std::cos(options.max_normal_change_degrees * PI / 180.0);
@@ -130,18 +138,17 @@ bool flip_intersects(const SurfaceMesh& mesh, const ElementHash& hash, const Fli
 }
 
 bool flip_sweeps_vertex(const SurfaceMesh& mesh, const ElementHash& hash, const FlipStencil& s) {
-    const Vec3 &a = mesh.position(s.a), &b = mesh.position(s.b);
-    const Vec3 &c = mesh.position(s.c), &d = mesh.position(s.d);
+    const auto [a, b, c, d] = positions_of(mesh, s);
     Box3d box(a);
     box.extend(b);
     box.extend(c);
     box.extend(d);
     std::vector<int> found;
-    hash.vertices().query(box, found);
+    hash.query_vertices(box, found);
     for (int vi : found) {
         if (!mesh.vertex_alive(vi) || vi == s.a || vi == s.b || vi == s.c || vi == s.d)
             continue;
-        if (point_in_tetrahedron(mesh.position(vi), a, b, c, d))
+        if (point_in_tetrahedron(mesh.position_near(vi, a), a, b, c, d))
             return true;
     }
     return false;

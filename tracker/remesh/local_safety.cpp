@@ -20,17 +20,25 @@ void sort_unique(std::vector<int>& v) {
     v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
-/// Positions at t0 and t1 and the identification of a pseudo-motion.
+/// Positions at t0 and t1 and the identification of a pseudo-motion. On a periodic mesh every
+/// vertex is read at its image nearest the first moving vertex (one reference for the whole
+/// check), and an end position at its image nearest the vertex's start.
 class MotionView {
 public:
     MotionView(const SurfaceMesh& mesh, const PseudoMotion& motion)
-        : m_mesh(mesh), m_motion(motion) {}
-    const Vec3& t0(int vi) const { return m_mesh.position(vi); }
-    const Vec3& t1(int vi) const {
+        : m_mesh(mesh),
+          m_motion(motion),
+          m_periodic(mesh.periodic() && !motion.vertices.empty()),
+          m_reference(m_periodic ? mesh.position(motion.vertices.front()) : Vec3::Zero()) {}
+    Vec3 t0(int vi) const {
+        return m_periodic ? m_mesh.position_near(vi, m_reference) : m_mesh.position(vi);
+    }
+    Vec3 t1(int vi) const {
         for (size_t k = 0; k < m_motion.vertices.size(); ++k)
             if (m_motion.vertices[k] == vi)
-                return m_motion.x_t1[k];
-        return m_mesh.position(vi);
+                return m_periodic ? m_mesh.periods().nearest_image(m_motion.x_t1[k], t0(vi))
+                                  : m_motion.x_t1[k];
+        return t0(vi);
     }
     int representative(int vi) const {
         return vi == m_motion.identified.second ? m_motion.identified.first : vi;
@@ -77,6 +85,8 @@ public:
 private:
     const SurfaceMesh& m_mesh;
     const PseudoMotion& m_motion;
+    const bool m_periodic;
+    const Vec3 m_reference;
 };
 
 }  // namespace
@@ -100,7 +110,7 @@ bool pseudo_motion_collides(const SurfaceMesh& mesh, const ElementHash& hash,
     // Moving vertices against static triangles and against moving triangles.
     for (int vi : moving) {
         const Box3d box = view.vertex_box(vi);
-        hash.triangles().query(box, found);
+        hash.query_triangles(box, found);
         for (int ti : found) {
             if (!mesh.triangle_alive(ti) || contains(moving_triangles, ti))
                 continue;
@@ -119,7 +129,7 @@ bool pseudo_motion_collides(const SurfaceMesh& mesh, const ElementHash& hash,
     // Static vertices against moving triangles.
     for (int ti : moving_triangles) {
         const Triangle& t = mesh.triangle(ti);
-        hash.vertices().query(view.triangle_box(t), found);
+        hash.query_vertices(view.triangle_box(t), found);
         for (int vi : found) {
             if (!mesh.vertex_alive(vi) || contains(moving, vi) || view.vertex_in_triangle(vi, t))
                 continue;
@@ -131,7 +141,7 @@ bool pseudo_motion_collides(const SurfaceMesh& mesh, const ElementHash& hash,
     for (size_t k = 0; k < moving_edges.size(); ++k) {
         const Edge& a = mesh.edge(moving_edges[k]);
         const Box3d box = view.edge_box(a);
-        hash.edges().query(box, found);
+        hash.query_edges(box, found);
         for (int ej : found) {
             if (!mesh.edge_alive(ej) || contains(moving_edges, ej))
                 continue;
@@ -153,11 +163,20 @@ bool pseudo_motion_collides(const SurfaceMesh& mesh, const ElementHash& hash,
 bool candidate_triangles_intersect(const SurfaceMesh& mesh, const ElementHash& hash,
                                    const CandidateTriangles& candidates,
                                    const std::vector<int>& replaced) {
-    auto position = [&](int vi) -> const Vec3& {
+    auto raw_position = [&](int vi) -> const Vec3& {
         for (const auto& [index, p] : candidates.overrides)
             if (index == vi)
                 return p;
         return mesh.position(vi);
+    };
+    // Periodic meshes: every vertex at its image nearest the first candidate's first corner
+    // (one reference, so a vertex two triangles share is the same point in both).
+    const bool periodic = mesh.periodic() && !candidates.triangles.empty();
+    const Vec3 reference =
+        periodic ? raw_position(candidates.triangles.front()[0]) : Vec3::Zero();
+    auto position = [&](int vi) -> Vec3 {
+        return periodic ? mesh.periods().nearest_image(raw_position(vi), reference)
+                        : raw_position(vi);
     };
     auto corners = [&](const Triangle& t) {
         return std::array<Vec3, 3>{position(t[0]), position(t[1]), position(t[2])};
@@ -173,7 +192,7 @@ bool candidate_triangles_intersect(const SurfaceMesh& mesh, const ElementHash& h
         Box3d box(p[0]);
         box.extend(p[1]);
         box.extend(p[2]);
-        hash.triangles().query(box, found);
+        hash.query_triangles(box, found);
         for (int ti : found) {
             if (!mesh.triangle_alive(ti) || contains(ignored, ti))
                 continue;

@@ -3,6 +3,7 @@
 #include "tracker/broadphase.h"
 #include "tracker/distance.h"
 #include "tracker/mesh_measures.h"
+#include "tracker/remesh/element_hash.h"
 
 #include <Eigen/Eigenvalues>
 #include <tbb/blocked_range.h>
@@ -40,7 +41,7 @@ std::vector<double> vertex_turning_curvature(const SurfaceMesh& mesh,
         for (int ei : mesh.vertex_edges(vi)) {
             const int wi = mesh.other_vertex(ei, vi);
             const Vec3& nw = normals[static_cast<size_t>(wi)];
-            const Vec3 x = mesh.position(wi) - mesh.position(vi);
+            const Vec3 x = mesh.position_near(wi, mesh.position(vi)) - mesh.position(vi);
             const double length2 = x.squaredNorm();
             if (!(length2 > 0.0) || nw.isZero())
                 continue;
@@ -89,8 +90,8 @@ std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
         if (!mesh.triangle_alive(ti))
             continue;
-        const auto& t = mesh.triangle(ti);
-        const Vec3 &a = mesh.position(t[0]), &b = mesh.position(t[1]), &c = mesh.position(t[2]);
+        // Periodic meshes: the corners at the minimum image of the first.
+        const auto [a, b, c] = mesh.triangle_positions(ti);
         const Vec3 normal = (b - a).cross(c - a);
         if (!(normal.squaredNorm() > 0.0))
             continue;
@@ -106,9 +107,13 @@ std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
         return distance;
     const double mean_extent = extent_sum / counted;
     SpatialHash triangles(mean_extent);
+    Box3d stored;  // union of the stored boxes, for the periodic images of a query
     for (int ti = 0; ti < mesh.num_triangles(); ++ti)
-        if (!triangle_normal[static_cast<size_t>(ti)].isZero())
+        if (!triangle_normal[static_cast<size_t>(ti)].isZero()) {
             triangles.insert(ti, boxes[static_cast<size_t>(ti)]);
+            stored.extend(boxes[static_cast<size_t>(ti)]);
+        }
+    const bool periodic = mesh.periodic();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
         std::vector<int> candidates;
         for (size_t vi = r.begin(); vi != r.end(); ++vi) {
@@ -120,21 +125,25 @@ std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
             // Nearest facing triangle within `reach` (the box query finds every triangle at
             // distance ≤ reach); first within one mean triangle size, which usually settles it.
             const auto nearest = [&](double reach) {
-                triangles.query(Box3d(x - Vec3::Constant(reach), x + Vec3::Constant(reach)),
-                                candidates);
+                const Box3d query(x - Vec3::Constant(reach), x + Vec3::Constant(reach));
+                if (periodic)
+                    query_periodic(triangles, stored, mesh.periods(), query, candidates);
+                else
+                    triangles.query(query, candidates);
                 double best = reach;
                 bool found = false;
                 for (int ti : candidates) {
-                    // The box's distance bounds the triangle's from below.
-                    if (triangles.box(ti).squaredExteriorDistance(x) > best * best)
+                    // The box's distance bounds the triangle's from below (periodic meshes: the
+                    // box may be at another image of the triangle than the one near x).
+                    if (!periodic && triangles.box(ti).squaredExteriorDistance(x) > best * best)
                         continue;
                     const auto& t = mesh.triangle(ti);
                     if (t[0] == v || t[1] == v || t[2] == v ||
                         !(triangle_normal[static_cast<size_t>(ti)].dot(nv) < -0.5))
                         continue;
-                    const double d = point_triangle_proximity(x, mesh.position(t[0]),
-                                                              mesh.position(t[1]),
-                                                              mesh.position(t[2]))
+                    const double d = point_triangle_proximity(x, mesh.position_near(t[0], x),
+                                                              mesh.position_near(t[1], x),
+                                                              mesh.position_near(t[2], x))
                                          .distance;
                     if (d <= best) {
                         best = d;
@@ -158,6 +167,21 @@ EdgeSizing::EdgeSizing(const SurfaceMesh& mesh, const RemeshOptions& options, do
     if (!(xi > 0.0) || !std::isfinite(xi))
         throw std::invalid_argument("EdgeSizing: xi must be finite and > 0");
     m_limits = remesh_limits(options, xi);
+    if (mesh.periodic()) {
+        // Every element must stay much shorter than a period for the minimum image to be
+        // unambiguous (periods.h): α is at most the smallest period over PERIOD_TO_EDGE_RATIO,
+        // and β shrinks with it so that β/α keeps its ratio (splits and collapses never undo
+        // each other).
+        double period = std::numeric_limits<double>::infinity();
+        for (int a = 0; a < 3; ++a)
+            if (mesh.periods().wraps(a))
+                period = std::min(period, mesh.periods().length[a]);
+        const double bound = period / MeshPeriods::PERIOD_TO_EDGE_RATIO;
+        if (m_limits.max_edge_length > bound) {
+            m_limits.min_edge_length *= bound / m_limits.max_edge_length;
+            m_limits.max_edge_length = bound;
+        }
+    }
     const double c = options.curvature_edge_fraction;
     const double f = options.thin_sheet_sag_fraction;
     if (c == 0.0 && f == 0.0)
@@ -218,7 +242,8 @@ void EdgeSizing::grade(const SurfaceMesh& mesh) {
         for (int ei : mesh.vertex_edges(vi)) {
             const int wi = mesh.other_vertex(ei, vi);
             const double reach =
-                h + SIZE_GRADING * (mesh.position(wi) - mesh.position(vi)).norm();
+                h + SIZE_GRADING *
+                        (mesh.position_near(wi, mesh.position(vi)) - mesh.position(vi)).norm();
             if (reach < target[static_cast<size_t>(wi)]) {
                 target[static_cast<size_t>(wi)] = reach;
                 m_scale[static_cast<size_t>(wi)] = reach / alpha;
@@ -239,8 +264,8 @@ void EdgeSizing::inherit(const SurfaceMesh& mesh, int vi, int a, int b) {
     const Vec3& x = mesh.position(vi);
     const double alpha = m_limits.max_edge_length;
     const double s = std::min(
-        {1.0, of(a) + SIZE_GRADING * (x - mesh.position(a)).norm() / alpha,
-         of(b) + SIZE_GRADING * (x - mesh.position(b)).norm() / alpha});
+        {1.0, of(a) + SIZE_GRADING * (x - mesh.position_near(a, x)).norm() / alpha,
+         of(b) + SIZE_GRADING * (x - mesh.position_near(b, x)).norm() / alpha});
     if (static_cast<size_t>(vi) >= m_scale.size())
         m_scale.resize(static_cast<size_t>(vi) + 1, 1.0);
     m_scale[static_cast<size_t>(vi)] = s;

@@ -51,7 +51,10 @@ std::vector<double> vertex_facing_distance(const SurfaceMesh& mesh,
 /// whose outer triangles are slivers (A4 with thin-sheet sizing: minimum angles of 0.1°).
 constexpr double SIZE_GRADING = 0.5;
 
-/// Edge-length limits for one split or collapse call. Curvature and facing distances are
+/// Edge-length limits for one split or collapse call. On a periodic mesh α is at most the
+/// smallest period over MeshPeriods::PERIOD_TO_EDGE_RATIO (β scaled with it, keeping β/α), so
+/// that remeshing never grows an edge to where the minimum image could be ambiguous; options
+/// and ξ are not changed (remesh_limits() still reports the unclamped values). Curvature and facing distances are
 /// measured when the object is built; vertices created afterwards get the nominal limits
 /// (s = 1) unless inherit() grades them from their split edge's endpoints.
 class EdgeSizing {

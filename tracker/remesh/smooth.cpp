@@ -30,10 +30,10 @@ constexpr size_t PAIRS_PER_TASK = 256;
 double smallest_angle_around(const SurfaceMesh& mesh, int vi) {
     double smallest = M_PI;
     for (int ti : mesh.vertex_triangles(vi)) {
-        const Triangle& t = mesh.triangle(ti);
+        const std::array<Vec3, 3> p = mesh.triangle_positions(ti);  // minimum image
         for (int k = 0; k < 3; ++k) {
-            const Vec3 a = mesh.position(t[(k + 1) % 3]) - mesh.position(t[k]);
-            const Vec3 b = mesh.position(t[(k + 2) % 3]) - mesh.position(t[k]);
+            const Vec3 a = p[(k + 1) % 3] - p[k];
+            const Vec3 b = p[(k + 2) % 3] - p[k];
             smallest = std::min(smallest, std::atan2(a.cross(b).norm(), a.dot(b)));
         }
     }
@@ -52,6 +52,11 @@ void hold_colliding_vertices(const SurfaceMesh& mesh, const std::vector<Vec3>& x
     // Holding a vertex shrinks its swept box to a point inside it, so the first round's
     // candidate pairs contain every later round's: the broad phase is built once.
     const BroadPhase broad(mesh, x_t0, x_t1, 0.0);
+    // Periodic meshes: every vertex of a pair is shifted by whole periods to the image of its
+    // start nearest the pair's first vertex, the same shift at both times (x_t1 is x_t0 plus
+    // a small displacement, not wrapped).
+    const bool periodic = mesh.periodic();
+    const MeshPeriods& periods = mesh.periods();
     const std::vector<VertexTrianglePair> vt = broad.vertex_triangle_pairs();
     const std::vector<EdgeEdgePair> ee = broad.edge_edge_pairs();
     // Vertices held in the last round (empty: the first round, which tests every pair). A pair
@@ -88,6 +93,21 @@ void hold_colliding_vertices(const SurfaceMesh& mesh, const std::vector<Vec3>& x
                     const auto p1 = [&](int k) -> const Vec3& {
                         return x_t1[static_cast<size_t>(v[k])];
                     };
+                    if (periodic) {
+                        std::array<Vec3, 4> a, b;
+                        for (int k = 0; k < 4; ++k) {
+                            const Vec3 shift = periods.shift_towards(p0(k), p0(0));
+                            a[static_cast<size_t>(k)] = p0(k) + shift;
+                            b[static_cast<size_t>(k)] = p1(k) + shift;
+                        }
+                        const bool collides =
+                            i < vt.size()
+                                ? point_triangle_ccd(a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3])
+                                : edge_edge_ccd(a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]);
+                        if (collides)
+                            local.local().insert(local.local().end(), v.begin(), v.end());
+                        continue;
+                    }
                     const bool collides =
                         i < vt.size()
                             ? point_triangle_ccd(p0(0), p0(1), p0(2), p0(3), p1(0), p1(1),
@@ -122,8 +142,8 @@ Vec3 vertex_volume_gradient(const SurfaceMesh& mesh, int vi) {
         const Triangle& t = mesh.triangle(ti);
         for (int k = 0; k < 3; ++k)
             if (t[k] == vi) {
-                six_gradient +=
-                    (mesh.position(t[(k + 1) % 3]) - x).cross(mesh.position(t[(k + 2) % 3]) - x);
+                six_gradient += (mesh.position_near(t[(k + 1) % 3], x) - x)
+                                    .cross(mesh.position_near(t[(k + 2) % 3], x) - x);
                 break;
             }
     }
@@ -163,10 +183,12 @@ std::vector<Vec3> null_space_displacements(const SurfaceMesh& mesh, const Remesh
             kind[slot] = q.feature == VertexFeature::ridge ? RIDGE : SMOOTH;
             Vec3 weighted_centroid = Vec3::Zero();
             double total_area = 0.0;
+            // Periodic meshes: the one-ring at its images nearest the vertex.
+            const Vec3& here = mesh.position(vi);
             for (int ti : mesh.vertex_triangles(vi)) {
                 const Triangle& t = mesh.triangle(ti);
-                const Vec3 &a = mesh.position(t[0]), &b = mesh.position(t[1]),
-                           &c = mesh.position(t[2]);
+                const Vec3 a = mesh.position_near(t[0], here), b = mesh.position_near(t[1], here),
+                           c = mesh.position_near(t[2], here);
                 const double area = 0.5 * (b - a).cross(c - a).norm();
                 weighted_centroid += area * (a + b + c) / 3.0;
                 total_area += area;
@@ -251,6 +273,7 @@ SmoothReport smooth_null_space(SurfaceMesh& mesh, const RemeshOptions& options,
             }
         }
         mesh.set_positions(x_t1);
+        mesh.wrap_positions();  // periodic meshes: back into the fundamental box
     }
     report.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -8,6 +8,7 @@
 #include "tracker/remesh/surface_fit.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -18,9 +19,10 @@ namespace meniscus::tracker {
 
 namespace {
 
+/// Length of edge ei (by the minimum image on a periodic mesh).
 double edge_length(const SurfaceMesh& mesh, int ei) {
-    const Edge& e = mesh.edge(ei);
-    return (mesh.position(e[0]) - mesh.position(e[1])).norm();
+    const std::array<Vec3, 2> p = mesh.edge_positions(ei);
+    return (p[0] - p[1]).norm();
 }
 
 }  // namespace
@@ -137,7 +139,9 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
                 touched.push_back(mesh.opposite_vertex(ti, ei));
             if (hash)
                 hash->begin_update(mesh, touched);
-            const int vi = mesh.split_edge(ei, midpoint, 0.5);
+            // On a periodic mesh the midpoint and the target are at the minimum image of the
+            // edge's first vertex: stored wrapped into the fundamental box.
+            const int vi = mesh.split_edge(ei, mesh.periods().wrap(midpoint), 0.5);
             sizing.inherit(mesh, vi, e[0], e[1]);
             touched.push_back(vi);
             if (hash)
@@ -163,7 +167,7 @@ SplitReport split_long_edges(SurfaceMesh& mesh, const RemeshOptions& options,
                 ++report.butterfly_collides;
                 continue;
             }
-            mesh.set_position(vi, *butterfly);
+            mesh.set_position(vi, mesh.periods().wrap(*butterfly));
             if (hash) {
                 hash->begin_update(mesh, {vi});
                 hash->refresh(mesh, {vi});

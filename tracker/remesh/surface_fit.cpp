@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -30,15 +31,22 @@ Vec3 any_orthogonal(const Vec3& n) {
     return n.cross(axis).normalized();
 }
 
-/// The vertices where the mesh has them.
+/// The vertices where the mesh has them. `near(vi, reference)`: at the image nearest
+/// `reference` on a periodic mesh (a stencil is read around one reference point).
 struct MeshPositions {
     const SurfaceMesh& mesh;
     const Vec3& operator()(int vi) const { return mesh.position(vi); }
+    Vec3 near(int vi, const Vec3& reference) const { return mesh.position_near(vi, reference); }
 };
-/// The vertices at given positions, one per vertex slot.
+/// The vertices at given positions, one per vertex slot (read with the mesh's periods).
 struct GivenPositions {
     const std::vector<Vec3>& positions;
+    const MeshPeriods* periods;  ///< null when the mesh is not periodic
     const Vec3& operator()(int vi) const { return positions[static_cast<size_t>(vi)]; }
+    Vec3 near(int vi, const Vec3& reference) const {
+        const Vec3& p = positions[static_cast<size_t>(vi)];
+        return periods ? periods->nearest_image(p, reference) : p;
+    }
 };
 
 /// Area vector (twice the area, along the normal) of live triangle ti.
@@ -46,7 +54,7 @@ template <typename Positions>
 Vec3 area_vector(const SurfaceMesh& mesh, const Positions& position, int ti) {
     const Triangle& t = mesh.triangle(ti);
     const Vec3& a = position(t[0]);
-    return (position(t[1]) - a).cross(position(t[2]) - a);
+    return (position.near(t[1], a) - a).cross(position.near(t[2], a) - a);
 }
 Vec3 area_vector(const SurfaceMesh& mesh, int ti) {
     return area_vector(mesh, MeshPositions{mesh}, ti);
@@ -315,7 +323,7 @@ std::optional<SurfacePatch> fit_patch(const SurfaceMesh& mesh, const Positions& 
     local.resize(ids.size());
     double radius_squared = 0.0;
     for (size_t i = 0; i < ids.size(); ++i) {
-        const Vec3 r = position(ids[i]) - origin;
+        const Vec3 r = position.near(ids[i], origin) - origin;
         local[i] = {r.dot(patch.u), r.dot(patch.v), r.dot(patch.normal)};
         radius_squared =
             std::max(radius_squared, local[i].x() * local[i].x() + local[i].y() * local[i].y());
@@ -438,7 +446,9 @@ std::optional<Vec3> fitted_edge_point(const SurfaceMesh& mesh, int ei,
     }
     if (!(normal.norm() > 0.0))
         return std::nullopt;
-    const Vec3 midpoint = 0.5 * (mesh.position(e[0]) + mesh.position(e[1]));
+    // Periodic meshes: the edge (and the fit, through fit_patch) at the minimum image of e[0].
+    const std::array<Vec3, 2> ends = mesh.edge_positions(ei);
+    const Vec3 midpoint = 0.5 * (ends[0] + ends[1]);
     const std::optional<SurfacePatch> patch =
         fit_surface_patch(mesh, vertices, triangles, midpoint, normal, options);
     if (!patch)
@@ -446,8 +456,8 @@ std::optional<Vec3> fitted_edge_point(const SurfaceMesh& mesh, int ei,
     // The least-squares surface misses the endpoints by its residuals there (a quadratic fitted
     // to a sphere cap sits above it in the middle): shift it by their mean so that it
     // interpolates the edge's ends on average.
-    const Vec3 residual = 0.5 * (patch->point_above(mesh.position(e[0])) - mesh.position(e[0]) +
-                                 patch->point_above(mesh.position(e[1])) - mesh.position(e[1]));
+    const Vec3 residual = 0.5 * (patch->point_above(ends[0]) - ends[0] +
+                                 patch->point_above(ends[1]) - ends[1]);
     const Vec3 point = patch->point_above(midpoint) - residual;
     if ((point - midpoint).norm() > options.max_offset_fraction * patch->radius)
         return std::nullopt;
@@ -465,7 +475,7 @@ std::optional<Vec3> arc_edge_point(const SurfaceMesh& mesh, int ei) {
             return std::nullopt;
         n[k] = *normal;
     }
-    const Vec3 p0 = mesh.position(e[0]), p1 = mesh.position(e[1]);
+    const auto [p0, p1] = mesh.edge_positions(ei);  // periodic: at the minimum image of e[0]
     const Vec3 chord = p1 - p0;
     const double length = chord.norm();
     if (!(length > 0.0) || n[0].dot(n[1]) < ARC_MIN_NORMAL_COSINE)
@@ -510,7 +520,9 @@ std::optional<SurfacePatch> vertex_patch(const SurfaceMesh& mesh,
                                          const SurfaceFitOptions& options) {
     if (positions.size() != static_cast<size_t>(mesh.num_vertices()))
         throw std::invalid_argument("positions: expected one per vertex slot");
-    return vertex_patch_at(mesh, GivenPositions{positions}, vi, options);
+    return vertex_patch_at(
+        mesh, GivenPositions{positions, mesh.periodic() ? &mesh.periods() : nullptr}, vi,
+        options);
 }
 
 std::optional<Vec3> place_on_vertex_patch(const SurfacePatch& patch, const Vec3& x,

@@ -19,6 +19,10 @@
 /// above `max_residual_fraction` of the patch size), or where the fitted point moves further
 /// than `max_offset_fraction` of the patch's size from the point it replaces: features
 /// (creases, corners) are left to the callers' sharp rules.
+///
+/// Periodic meshes (issue 39): a patch is read at the minimum image of its origin (the vertex,
+/// or the edge's first vertex), and the points returned for an edge or a vertex are near that
+/// vertex, not wrapped: callers wrap a point before storing it as a vertex position.
 
 #include "tracker/mesh.h"
 #include "tracker/quadric.h"

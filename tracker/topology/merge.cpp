@@ -5,6 +5,7 @@
 #include "tracker/remesh/local_safety.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <memory>
 #include <numeric>
@@ -28,10 +29,17 @@ std::array<int, 4> facing_loop(const EdgeHole& b, int shift) {
 
 double alignment_cost(const SurfaceMesh& mesh, const EdgeHole& a, const EdgeHole& b, int shift) {
     const std::array<int, 4> f = facing_loop(b, shift);
+    // A periodic mesh's two loops are read about one reference (loop a's first vertex).
+    const Vec3& ref = mesh.position(a.loop[0]);
     double cost = 0.0;
     for (size_t i = 0; i < LOOP_SIZE; ++i)
-        cost += (mesh.position(a.loop[i]) - mesh.position(f[i])).squaredNorm();
+        cost += (mesh.position_near(a.loop[i], ref) - mesh.position_near(f[i], ref)).squaredNorm();
     return cost;
+}
+
+/// The squared distance between two points, between their nearest images on a periodic mesh.
+double squared_separation(const SurfaceMesh& mesh, const Vec3& p, const Vec3& q) {
+    return mesh.periodic() ? mesh.periods().difference(p, q).squaredNorm() : (p - q).squaredNorm();
 }
 
 /// A proximal edge pair, by vertices (edge indices change as merges rewire the mesh).
@@ -81,13 +89,15 @@ bool merge_shares_vertex(const EdgeHole& a, const EdgeHole& b) {
 std::vector<Triangle> zipper_triangles(const SurfaceMesh& mesh, const EdgeHole& a,
                                        const EdgeHole& b, int shift) {
     const std::array<int, 4> f = facing_loop(b, shift);
+    const Vec3& ref = mesh.position(a.loop[0]);  // a periodic mesh's loops are read about it
+    const auto x = [&](int v) { return mesh.position_near(v, ref); };
     std::vector<Triangle> band;
     for (size_t i = 0; i < LOOP_SIZE; ++i) {
         const size_t j = (i + 1) % LOOP_SIZE;
         const int a_i = a.loop[i], a_j = a.loop[j], b_i = f[i], b_j = f[j];
         // Loop a is used as a_i → a_j and loop b as b_j → b_i, as the removed triangles did.
-        const double diagonal_ab = (mesh.position(a_i) - mesh.position(b_j)).squaredNorm();
-        const double diagonal_ba = (mesh.position(a_j) - mesh.position(b_i)).squaredNorm();
+        const double diagonal_ab = (x(a_i) - x(b_j)).squaredNorm();
+        const double diagonal_ba = (x(a_j) - x(b_i)).squaredNorm();
         if (diagonal_ab <= diagonal_ba) {
             band.push_back({a_i, a_j, b_j});
             band.push_back({b_j, b_i, a_i});
@@ -129,14 +139,21 @@ MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& optio
 
     // Pairs of manifold edges closer than the merge distance: boxes padded by half of it
     // overlap for every such pair, and the exact distance is tested inside the parallel join.
-    const auto proximity = [&mesh](int ei, int ej) {
+    // On a periodic mesh both edges are read about the first edge's first vertex (the broad
+    // phase reports pairs across the seam too).
+    const auto ends = [&mesh](int ei, int ej) {
         const Edge& a = mesh.edge(ei);
         const Edge& b = mesh.edge(ej);
-        return edge_edge_proximity(mesh.position(a[0]), mesh.position(a[1]),
-                                   mesh.position(b[0]), mesh.position(b[1]));
+        const Vec3& ref = mesh.position(a[0]);
+        return std::array<Vec3, 4>{ref, mesh.position_near(a[1], ref),
+                                   mesh.position_near(b[0], ref), mesh.position_near(b[1], ref)};
     };
-    const std::vector<EdgeEdgePair> close = static_edge_edge_pairs(
-        mesh, 0.5 * merge_distance, [&](int ei, int ej) {
+    const auto proximity = [&ends](int ei, int ej) {
+        const std::array<Vec3, 4> x = ends(ei, ej);
+        return edge_edge_proximity(x[0], x[1], x[2], x[3]);
+    };
+    const std::vector<EdgeEdgePair> close =
+        static_edge_edge_pairs(mesh, 0.5 * merge_distance, [&](int ei, int ej) {
             return mesh.edge_triangles(ei).size() == 2 && mesh.edge_triangles(ej).size() == 2 &&
                    proximity(ei, ej).distance < merge_distance;
         });
@@ -145,10 +162,13 @@ MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& optio
     for (const EdgeEdgePair& pair : close) {
         const Edge& a = mesh.edge(pair.ei);
         const Edge& b = mesh.edge(pair.ej);
-        const EdgeEdgeProximity p = proximity(pair.ei, pair.ej);
-        const Vec3 on_a = (1.0 - p.s) * mesh.position(a[0]) + p.s * mesh.position(a[1]);
-        const Vec3 on_b = (1.0 - p.u) * mesh.position(b[0]) + p.u * mesh.position(b[1]);
-        candidates.push_back({p.distance, a, b, 0.5 * (on_a + on_b)});
+        const std::array<Vec3, 4> x = ends(pair.ei, pair.ej);
+        const EdgeEdgeProximity p = edge_edge_proximity(x[0], x[1], x[2], x[3]);
+        const Vec3 on_a = (1.0 - p.s) * x[0] + p.s * x[1];
+        const Vec3 on_b = (1.0 - p.u) * x[2] + p.u * x[3];
+        const Vec3 midpoint = 0.5 * (on_a + on_b);
+        candidates.push_back(
+            {p.distance, a, b, mesh.periodic() ? mesh.periods().wrap(midpoint) : midpoint});
     }
     report.candidates = static_cast<int>(candidates.size());
     if (candidates.empty()) {
@@ -174,7 +194,7 @@ MergeReport merge_proximal_edges(SurfaceMesh& mesh, const TopologyOptions& optio
     for (const Candidate& c : candidates) {
         context.cancel.throw_if_requested("merging");
         const bool near_merge = std::any_of(merged_at.begin(), merged_at.end(), [&](const Vec3& m) {
-            return (m - c.midpoint).squaredNorm() < spacing * spacing;
+            return squared_separation(mesh, m, c.midpoint) < spacing * spacing;
         });
         if (near_merge) {
             ++report.deferred_near_merge;

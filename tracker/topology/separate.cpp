@@ -8,9 +8,9 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdint>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <numeric>
@@ -107,8 +107,8 @@ std::vector<std::pair<int, int>> wedge_pairs(const SurfaceMesh& mesh, int ei) {
         return pairs;
     }
     const Edge& edge = mesh.edge(ei);
-    const Vec3& a = mesh.position(edge[0]);
-    const Vec3 e = (mesh.position(edge[1]) - a).normalized();
+    const Vec3& a = mesh.position(edge[0]);  // a periodic mesh's fins are read about it
+    const Vec3 e = (mesh.position_near(edge[1], a) - a).normalized();
     // Any unit vector perpendicular to e, and its quarter turn about e.
     const Vec3 u = e.unitOrthogonal(), w = e.cross(u);
     struct Fin {
@@ -126,7 +126,7 @@ std::vector<std::pair<int, int>> wedge_pairs(const SurfaceMesh& mesh, int ei) {
                 c = t[k];
             a_to_b = a_to_b || (t[k] == edge[0] && t[(k + 1) % 3] == edge[1]);
         }
-        const Vec3 d = mesh.position(c) - a;
+        const Vec3 d = mesh.position_near(c, a) - a;
         fins.push_back({std::atan2(d.dot(w), d.dot(u)), a_to_b, ti});
     }
     std::sort(fins.begin(), fins.end(),
@@ -208,16 +208,24 @@ bool one_manifold_fan(const SurfaceMesh& mesh, int vi) {
     return false;
 }
 
+/// The mean of the fan's vertices other than vi; on a periodic mesh of their images nearest vi
+/// (so near vi, possibly outside the box).
 Vec3 fan_centroid(const SurfaceMesh& mesh, const std::vector<int>& fan, int vi) {
+    const Vec3& x = mesh.position(vi);
     Vec3 sum = Vec3::Zero();
     int count = 0;
     for (int ti : fan)
         for (int v : mesh.triangle(ti))
             if (v != vi) {
-                sum += mesh.position(v);
+                sum += mesh.position_near(v, x);
                 ++count;
             }
     return sum / count;
+}
+
+/// p as a vertex position: wrapped into the box on a periodic mesh.
+Vec3 stored_position(const SurfaceMesh& mesh, const Vec3& p) {
+    return mesh.periodic() ? mesh.periods().wrap(p) : p;
 }
 
 }  // namespace
@@ -307,8 +315,9 @@ SeparationReport separate(SurfaceMesh& mesh, const SeparationOptions& options,
         bool accepted = false;
         std::vector<Vec3> nudged(fans.size());
         for (int attempt = 0; attempt <= options.max_nudge_halvings; ++attempt) {
+            // Towards each fan's centroid, read about x; wrapped back on a periodic mesh.
             for (size_t k = 0; k < fans.size(); ++k)
-                nudged[k] = x + fraction * (centroids[k] - x);
+                nudged[k] = stored_position(mesh, x + fraction * (centroids[k] - x));
             if (!hash) {
                 accepted = true;
                 break;
@@ -371,7 +380,9 @@ EdgeManifoldReport make_edge_manifold(SurfaceMesh& mesh) {
         MENISCUS_ASSERT(mesh.edge_alive(ei) && mesh.is_nonmanifold_edge(ei),
                         "a non-manifold edge vanished while splitting another");
         const Edge e = mesh.edge(ei);
-        const int m = mesh.split_edge(ei, 0.5 * (mesh.position(e[0]) + mesh.position(e[1])), 0.5);
+        const Vec3& p0 = mesh.position(e[0]);
+        const int m = mesh.split_edge(
+            ei, stored_position(mesh, 0.5 * (p0 + mesh.position_near(e[1], p0))), 0.5);
         report.added.push_back({m, e[0], e[1], 0.5});
     }
     // 2. One copy per fan of every singular vertex.
