@@ -153,6 +153,10 @@ public:
         const size_t vt_count = m_candidates.vertex_triangle.size();
         const std::vector<Contact> contacts = ordered_parallel_collect<Contact>(
             vt_count + m_candidates.edge_edge.size(), [&](size_t i, std::vector<Contact>& out) {
+                if (m_mesh.periodic()) {
+                    repel_periodic(i, vt_count, padding, out);
+                    return;
+                }
                 if (i < vt_count) {
                     const VertexTrianglePair& p = m_candidates.vertex_triangle[i];
                     const Triangle& t = m_mesh.triangle(p.ti);
@@ -396,7 +400,9 @@ private:
             for (int ei = 0; ei < m_mesh.num_edges(); ++ei)
                 if (m_mesh.edge_alive(ei)) {
                     const Edge& e = m_mesh.edge(ei);
-                    sum += (x0(e[1]) - x0(e[0])).norm();
+                    sum += m_mesh.periodic()
+                               ? m_mesh.periods().difference(x0(e[1]), x0(e[0])).norm()
+                               : (x0(e[1]) - x0(e[0])).norm();
                     ++count;
                 }
             m_mean_edge_length = count > 0 ? sum / count : 0.0;
@@ -457,6 +463,86 @@ private:
         return b;
     }
 
+    // ---- periodic meshes (issue 39): every pair read by the minimum image ----------------
+    // The pair's vertices v (v[0] the first vertex of its first element) at their images
+    // nearest x0(v[0]): vertex k at x0(v[k]) + s_k and x1[v[k]] + s_k, the same shift at both
+    // times, s_k = shift_towards(x0(v[k]), x0(v[0])).
+
+    void unwrap(const std::array<int, 4>& v, const std::vector<Vec3>& x1, std::array<Vec3, 4>& p0,
+                std::array<Vec3, 4>& p1) const {
+        const MeshPeriods& periods = m_mesh.periods();
+        const Vec3& ref = x0(v[0]);
+        for (size_t k = 0; k < 4; ++k) {
+            const auto i = static_cast<size_t>(v[k]);
+            const Vec3 s = k == 0 ? Vec3::Zero() : periods.shift_towards(m_x0[i], ref);
+            p0[k] = m_x0[i] + s;
+            p1[k] = x1[i] + s;
+        }
+    }
+
+    void unwrap_t0(const std::array<int, 4>& v, std::array<Vec3, 4>& p0) const {
+        const MeshPeriods& periods = m_mesh.periods();
+        const Vec3& ref = x0(v[0]);
+        p0[0] = ref;
+        for (size_t k = 1; k < 4; ++k)
+            p0[k] = periods.nearest_image(x0(v[k]), ref);
+    }
+
+    /// Do the swept boxes of the pair's first `split` vertices and of the others overlap,
+    /// read by the minimum image?
+    bool swept_boxes_overlap(const std::array<int, 4>& v, size_t split,
+                             const std::vector<Vec3>& x1) const {
+        std::array<Vec3, 4> p0, p1;
+        unwrap(v, x1, p0, p1);
+        Box3d a, b;
+        for (size_t k = 0; k < 4; ++k) {
+            Box3d& box = k < split ? a : b;
+            box.extend(p0[k]);
+            box.extend(p1[k]);
+        }
+        return boxes_overlap(a, b);
+    }
+
+    /// repel()'s test of candidate i on a periodic mesh.
+    void repel_periodic(size_t i, size_t vt_count, double padding,
+                        std::vector<Contact>& out) const {
+        std::array<int, 4> v;
+        size_t split = 1;
+        if (i < vt_count) {
+            const VertexTrianglePair& p = m_candidates.vertex_triangle[i];
+            const Triangle& t = m_mesh.triangle(p.ti);
+            v = {p.vi, t[0], t[1], t[2]};
+        } else {
+            const EdgeEdgePair& p = m_candidates.edge_edge[i - vt_count];
+            const Edge& a = m_mesh.edge(p.ei);
+            const Edge& b = m_mesh.edge(p.ej);
+            v = {a[0], a[1], b[0], b[1]};
+            split = 2;
+        }
+        std::array<Vec3, 4> q;
+        unwrap_t0(v, q);
+        Box3d a, b;
+        for (size_t k = 0; k < 4; ++k)
+            (k < split ? a : b).extend(q[k]);
+        a.min().array() -= padding;
+        a.max().array() += padding;
+        b.min().array() -= padding;
+        b.max().array() += padding;
+        if (!boxes_overlap(a, b))
+            return;
+        if (split == 1) {
+            const auto prox = point_triangle_proximity(q[0], q[1], q[2], q[3]);
+            if (prox.distance < m_o.proximity_epsilon)
+                out.push_back(
+                    {v, prox.weights, prox.normal, m_o.proximity_epsilon - prox.distance});
+        } else {
+            const auto prox = edge_edge_proximity(q[0], q[1], q[2], q[3]);
+            if (prox.distance < m_o.proximity_epsilon)
+                out.push_back(
+                    {v, prox.weights, prox.normal, m_o.proximity_epsilon - prox.distance});
+        }
+    }
+
     static bool boxes_overlap(const Box3d& a, const Box3d& b) {
         return (a.min().array() <= b.max().array()).all() &&
                (b.min().array() <= a.max().array()).all();
@@ -479,8 +565,11 @@ private:
             all.size(), [&](size_t i, std::vector<VertexTrianglePair>& out) {
                 const VertexTrianglePair& p = all[i];
                 const Triangle& t = m_mesh.triangle(p.ti);
-                if (any_changed(changed, {p.vi, t[0], t[1], t[2]}) &&
-                    boxes_overlap(moving_box({p.vi}, x1), moving_box({t[0], t[1], t[2]}, x1)))
+                if (!any_changed(changed, {p.vi, t[0], t[1], t[2]}))
+                    return;
+                if (m_mesh.periodic() ? swept_boxes_overlap({p.vi, t[0], t[1], t[2]}, 1, x1)
+                                      : boxes_overlap(moving_box({p.vi}, x1),
+                                                      moving_box({t[0], t[1], t[2]}, x1)))
                     out.push_back(p);
             });
     }
@@ -492,14 +581,29 @@ private:
                 const EdgeEdgePair& p = all[i];
                 const Edge& a = m_mesh.edge(p.ei);
                 const Edge& b = m_mesh.edge(p.ej);
-                if (any_changed(changed, {a[0], a[1], b[0], b[1]}) &&
-                    boxes_overlap(moving_box({a[0], a[1]}, x1), moving_box({b[0], b[1]}, x1)))
+                if (!any_changed(changed, {a[0], a[1], b[0], b[1]}))
+                    return;
+                if (m_mesh.periodic() ? swept_boxes_overlap({a[0], a[1], b[0], b[1]}, 2, x1)
+                                      : boxes_overlap(moving_box({a[0], a[1]}, x1),
+                                                      moving_box({b[0], b[1]}, x1)))
                     out.push_back(p);
             });
     }
 
     void test(const std::array<int, 4>& v, const std::vector<Vec3>& x1, bool edge_edge,
               double target, std::vector<Contact>& out) const {
+        if (m_mesh.periodic()) {
+            std::array<Vec3, 4> q0, q1;
+            unwrap(v, x1, q0, q1);
+            const CcdResult r =
+                edge_edge ? edge_edge_ccd_detailed(q0[0], q0[1], q0[2], q0[3], q1[0], q1[1], q1[2],
+                                                   q1[3])
+                          : point_triangle_ccd_detailed(q0[0], q0[1], q0[2], q0[3], q1[0], q1[1],
+                                                        q1[2], q1[3]);
+            if (r.may_collide)
+                out.push_back({v, r.weights, r.normal, target, edge_edge});
+            return;
+        }
         const auto p0 = [&](int k) -> const Vec3& { return m_x0[static_cast<size_t>(v[k])]; };
         const auto p1 = [&](int k) -> const Vec3& { return x1[static_cast<size_t>(v[k])]; };
         // One detailed query: its may_collide is the boolean query's answer (ccd.h), and a hit
@@ -578,12 +682,18 @@ private:
                     d[static_cast<size_t>(v)].setZero();
                 continue;
             }
+            // Periodic meshes: the zone's vertices at their images nearest its first vertex
+            // (a zone is a cluster of contacts, far smaller than half a period).
+            const auto at = [&](int v) -> Vec3 {
+                return m_mesh.periodic() ? m_mesh.periods().nearest_image(x0(v), x0(zone.front()))
+                                         : x0(v);
+            };
             double mass = 0.0;
             Vec3 com = Vec3::Zero(), momentum = Vec3::Zero();
             for (int v : zone) {
                 const double mv = 1.0 / m_inv_mass[static_cast<size_t>(v)];
                 mass += mv;
-                com += mv * x0(v);
+                com += mv * at(v);
                 momentum += mv * d[static_cast<size_t>(v)];
             }
             com /= mass;
@@ -592,13 +702,13 @@ private:
             Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
             for (int v : zone) {
                 const double mv = 1.0 / m_inv_mass[static_cast<size_t>(v)];
-                const Vec3 r = x0(v) - com;
+                const Vec3 r = at(v) - com;
                 angular += mv * r.cross(d[static_cast<size_t>(v)] - linear);
                 inertia += mv * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
             }
             const Vec3 omega = inertia.completeOrthogonalDecomposition().solve(angular);
             for (int v : zone)
-                d[static_cast<size_t>(v)] = linear + omega.cross(x0(v) - com);
+                d[static_cast<size_t>(v)] = linear + omega.cross(at(v) - com);
         }
     }
 

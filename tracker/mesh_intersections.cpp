@@ -19,9 +19,23 @@ std::array<Vec3, 3> corners(const std::vector<Vec3>& x, const Triangle& t) {
             x[static_cast<size_t>(t[2])]};
 }
 
+/// Periodic meshes (issue 39): triangle t's corners at their images nearest `ref`.
+std::array<Vec3, 3> corners_near(const MeshPeriods& periods, const std::vector<Vec3>& x,
+                                 const Triangle& t, const Vec3& ref) {
+    return {periods.nearest_image(x[static_cast<size_t>(t[0])], ref),
+            periods.nearest_image(x[static_cast<size_t>(t[1])], ref),
+            periods.nearest_image(x[static_cast<size_t>(t[2])], ref)};
+}
+
 bool pair_intersects(const SurfaceMesh& mesh, const std::vector<Vec3>& x, const TrianglePair& p) {
     const Triangle& a = mesh.triangle(p.ti);
     const Triangle& b = mesh.triangle(p.tj);
+    if (mesh.periodic()) {
+        // Both triangles by the minimum image about the first one's first corner.
+        const Vec3& ref = x[static_cast<size_t>(a[0])];
+        return triangles_intersect(corners_near(mesh.periods(), x, a, ref), a,
+                                   corners_near(mesh.periods(), x, b, ref), b);
+    }
     return triangles_intersect(corners(x, a), a, corners(x, b), b);
 }
 
@@ -39,6 +53,16 @@ void add_witnesses(const SurfaceMesh& mesh, const std::vector<Vec3>& x, int ta, 
         const Edge& e = mesh.edge(ei);
         if (edge_shares_vertex(e, t))
             continue;
+        if (mesh.periodic()) {
+            const MeshPeriods& periods = mesh.periods();
+            const Vec3& ref = x[static_cast<size_t>(e[0])];
+            const std::array<Vec3, 3> c = corners_near(periods, x, t, ref);
+            if (segment_triangle_intersection(
+                    ref, periods.nearest_image(x[static_cast<size_t>(e[1])], ref), c[0], c[1], c[2])
+                    .intersects())
+                out.push_back({ei, tb});
+            continue;
+        }
         if (segment_triangle_intersection(
                 x[static_cast<size_t>(e[0])], x[static_cast<size_t>(e[1])],
                 x[static_cast<size_t>(t[0])], x[static_cast<size_t>(t[1])],

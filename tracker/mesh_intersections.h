@@ -28,6 +28,9 @@ struct IntersectionReport {
 
 /// Finds all self-intersections of the live triangles at `positions` (sized
 /// mesh.num_vertices(); the mesh's own positions when null).
+/// A periodic mesh (issue 39) is read with its periods: the broad phase pairs triangles across
+/// the box's faces and each pair is tested at the images nearest the first triangle's first
+/// corner (`positions` need not be wrapped).
 IntersectionReport find_self_intersections(const SurfaceMesh& mesh,
                                            const std::vector<Vec3>* positions = nullptr);
 

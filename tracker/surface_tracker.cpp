@@ -3,8 +3,11 @@
 #include "tracker/mesh_intersections.h"
 #include "tracker/mesh_measures.h"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -16,6 +19,30 @@ namespace {
 /// this fraction of its edges join far-apart indices (SurfaceMesh::far_edge_fraction): about
 /// 0.07–0.14 right after a renumbering, 0.6–0.8 for a mesher's order or a long run's.
 constexpr double REORDER_FAR_EDGE_FRACTION = 0.2;
+
+/// Throws std::invalid_argument when a wrapping period of `mesh` is shorter than
+/// MeshPeriods::PERIOD_TO_EDGE_RATIO times its longest live edge (read by the minimum image):
+/// the minimum image of an element, and of the pairs collision handling reads, would be
+/// ambiguous.
+void check_periods(const SurfaceMesh& mesh) {
+    double longest = 0.0;
+    for (int ei = 0; ei < mesh.num_edges(); ++ei)
+        if (mesh.edge_alive(ei)) {
+            const std::array<Vec3, 2> ends = mesh.edge_positions(ei);
+            longest = std::max(longest, (ends[1] - ends[0]).norm());
+        }
+    static const char* names[3] = {"x", "y", "z"};
+    const MeshPeriods& periods = mesh.periods();
+    for (int a = 0; a < 3; ++a)
+        if (periods.wraps(a) && periods.length[a] < MeshPeriods::PERIOD_TO_EDGE_RATIO * longest) {
+            std::ostringstream message;
+            message << "SurfaceTracker: the period along " << names[a] << " (" << periods.length[a]
+                    << " m) is shorter than " << MeshPeriods::PERIOD_TO_EDGE_RATIO
+                    << " times the longest edge (" << longest
+                    << " m): refine the mesh or lengthen the period";
+            throw std::invalid_argument(message.str());
+        }
+}
 
 }  // namespace
 
@@ -57,6 +84,8 @@ SurfaceTracker::SurfaceTracker(SurfaceMesh mesh, const TrackerOptions& options)
         throw std::invalid_argument("SurfaceTracker: the mesh has no edges");
     m_options.collision.proximity_epsilon = m_options.proximity_fraction * m_xi;
     m_options.collision.cancel = m_options.cancel;
+    if (m_mesh.periodic())
+        check_periods(m_mesh);
 }
 
 ImproveReport SurfaceTracker::improve(const std::vector<std::uint8_t>* pinned) {
@@ -118,6 +147,7 @@ IntegrateResult SurfaceTracker::integrate(const std::vector<Vec3>& velocities, d
             resolve_collisions(m_mesh, x0, x1, dt, m_options.collision, nullptr, pinned);
     result.time_advanced = dt * result.collisions.motion_fraction;
     m_mesh.set_positions(x1);
+    m_mesh.wrap_positions();  // periodic meshes: back into the fundamental box (else no-op)
     if (m_options.verify_intersection_free)
         result.intersecting_pairs =
             static_cast<int>(find_self_intersections(m_mesh).triangle_pairs.size());

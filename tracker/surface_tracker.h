@@ -52,7 +52,10 @@ struct IntegrateResult {
 class SurfaceTracker {
 public:
     /// Takes the initial mesh (must be non-empty; intersection-free for the guarantee) and
-    /// options (validated; throws std::invalid_argument naming the field).
+    /// options (validated; throws std::invalid_argument naming the field). A periodic mesh
+    /// (issue 39) must have every wrapping period at least MeshPeriods::PERIOD_TO_EDGE_RATIO
+    /// times its longest edge (else std::invalid_argument naming the axis); integrate() wraps
+    /// its positions back into the fundamental box after each motion.
     SurfaceTracker(SurfaceMesh mesh, const TrackerOptions& options);
 
     SurfaceMesh& mesh() { return m_mesh; }

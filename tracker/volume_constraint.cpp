@@ -2,6 +2,7 @@
 
 #include "tracker/mesh_measures.h"
 
+#include <array>
 #include <stdexcept>
 #include <string>
 
@@ -12,6 +13,27 @@ namespace {
 /// Six times the signed volume of the tetrahedron (ref, a, b, c).
 double tet6(const Vec3& ref, const Vec3& a, const Vec3& b, const Vec3& c) {
     return (a - ref).dot((b - ref).cross(c - ref));
+}
+
+/// The axis of the divergence theorem for a periodic mesh (issue 39): V = ∮ (x_a − c) n_a dA,
+/// exact for a surface closed in the periodic box when axis a does not wrap (the field is then
+/// periodic along the others). The first axis that does not wrap; z when all three do — the
+/// volume is then defined up to a constant per component, which the differences that
+/// resolve_collisions corrects do not see (positions x0 + d move continuously, so each
+/// triangle keeps its image), and its gradient is still ⅓ Σ A_t.
+int divergence_axis(const MeshPeriods& periods) {
+    for (int a = 0; a < 3; ++a)
+        if (!periods.wraps(a))
+            return a;
+    return 2;
+}
+
+/// Corners of triangle t at `positions`, each at its image nearest the first (periodic mesh).
+std::array<Vec3, 3> unwrapped_corners(const MeshPeriods& periods,
+                                      const std::vector<Vec3>& positions, const Triangle& t) {
+    const Vec3& a = positions[static_cast<size_t>(t[0])];
+    return {a, periods.nearest_image(positions[static_cast<size_t>(t[1])], a),
+            periods.nearest_image(positions[static_cast<size_t>(t[2])], a)};
 }
 
 void check_size(const char* what, size_t got, size_t expected) {
@@ -65,8 +87,24 @@ std::vector<double> component_volumes_at(const SurfaceMesh& mesh,
         throw std::invalid_argument("component_volumes_at: " + std::to_string(positions.size()) +
                                     " positions for " + std::to_string(mesh.num_vertices()) +
                                     " vertex slots");
-    // Each component about one of its own vertices, to keep round-off small.
     const size_t n = static_cast<size_t>(components.count);
+    if (mesh.periodic()) {
+        const MeshPeriods& periods = mesh.periods();
+        const int axis = divergence_axis(periods);
+        const double c = periods.origin[axis];
+        std::vector<double> volume(n, 0.0);
+        for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
+            if (!mesh.triangle_alive(ti))
+                continue;
+            const auto k =
+                static_cast<size_t>(components.triangle_component[static_cast<size_t>(ti)]);
+            const std::array<Vec3, 3> x = unwrapped_corners(periods, positions, mesh.triangle(ti));
+            const double area_a = 0.5 * (x[1] - x[0]).cross(x[2] - x[0])[axis];
+            volume[k] += ((x[0][axis] + x[1][axis] + x[2][axis]) / 3.0 - c) * area_a;
+        }
+        return volume;
+    }
+    // Each component about one of its own vertices, to keep round-off small.
     std::vector<double> six_v(n, 0.0);
     std::vector<Vec3> ref(n, Vec3::Zero());
     std::vector<std::uint8_t> has_ref(n, 0);
@@ -105,10 +143,16 @@ std::vector<Vec3> volume_restoring_displacements(const SurfaceMesh& mesh,
         if (!mesh.triangle_alive(ti))
             continue;
         const Triangle& t = mesh.triangle(ti);
-        const Vec3& a = positions[static_cast<size_t>(t[0])];
-        const Vec3& b = positions[static_cast<size_t>(t[1])];
-        const Vec3& c = positions[static_cast<size_t>(t[2])];
-        const Vec3 third_area = (b - a).cross(c - a) / 6.0;  // ⅓ of the area vector
+        Vec3 third_area;  // ⅓ of the area vector
+        if (mesh.periodic()) {
+            const std::array<Vec3, 3> x = unwrapped_corners(mesh.periods(), positions, t);
+            third_area = (x[1] - x[0]).cross(x[2] - x[0]) / 6.0;
+        } else {
+            const Vec3& a = positions[static_cast<size_t>(t[0])];
+            const Vec3& b = positions[static_cast<size_t>(t[1])];
+            const Vec3& c = positions[static_cast<size_t>(t[2])];
+            third_area = (b - a).cross(c - a) / 6.0;
+        }
         for (int vi : t)
             gradient[static_cast<size_t>(vi)] += third_area;
     }

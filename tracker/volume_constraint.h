@@ -37,7 +37,11 @@ struct VolumeComponents {
 VolumeComponents volume_components(const SurfaceMesh& mesh);
 
 /// Signed enclosed volume of each component (m³, indexed by component id) with the vertices at
-/// `positions` (sized mesh.num_vertices()).
+/// `positions` (sized mesh.num_vertices()). A periodic mesh (issue 39) is read by the minimum
+/// image and its volumes come from the divergence theorem along its first axis that does not
+/// wrap, V = ∮ (x_a − origin_a) n_a dA: exact for a column closed through the box's faces; a
+/// layer periodic along the other two axes gets its volume above origin_a. When all three axes
+/// wrap, along z: defined up to a constant per component (volume changes are exact).
 std::vector<double> component_volumes_at(const SurfaceMesh& mesh,
                                          const VolumeComponents& components,
                                          const std::vector<Vec3>& positions);
