@@ -397,27 +397,38 @@ struct TubeCase {
     double grade;  ///< a of graded_tube
     int around;    ///< vertices per ring
     bool seam_splits, seam_collapses;
+    bool fitted = false;  ///< fitted-surface points and smoothing
 };
 
 TEST(PeriodicImprove, TubeStaysAValidIntersectionFreeTubeOfTheSameVolume) {
     const double radius = 0.25, length = 1.0;
     // Fine target, coarse seam (splits there); coarse target (α clamped to L/8), fine seam
-    // (collapses there); a uniform tube already in range.
+    // (collapses there); a uniform tube already in range; the first two with fitted points (with
+    // two smoothing steps onto the fitted surface the fine seam rings spread out before any
+    // collapse: no short seam edge is left, but none needs collapsing across the seam).
     for (const TubeCase& c :
          {TubeCase{0.05, 0.6, 14, true, false}, TubeCase{0.09, -0.8, 24, false, true},
-          TubeCase{0.1, 0.0, 14, false, false}}) {
+          TubeCase{0.1, 0.0, 14, false, false}, TubeCase{0.05, 0.6, 14, true, false, true},
+          TubeCase{0.09, -0.8, 24, false, false, true}}) {
         // The seam along a ring (z = 0), and through the seam ring's triangles (z = −0.008).
         for (double origin_z : {0.0, -0.008}) {
             SurfaceMesh mesh = graded_tube(radius, length, c.around, 12, c.grade, origin_z);
             const std::string what = "xi " + std::to_string(c.xi) + " grade " +
                                      std::to_string(c.grade) + " origin " +
-                                     std::to_string(origin_z);
+                                     std::to_string(origin_z) + (c.fitted ? " fitted" : "");
             const double v0 = volume_along(mesh, 0);
             EXPECT_GT(v0, 0.0);
             SeamCounter counter;
             counter.mesh = &mesh;
             mesh.add_observer(&counter);
             RemeshOptions options;
+            if (c.fitted) {
+                // New and smoothed vertices on the fitted surface (surface_fit.h).
+                options.split_on_fitted_surface = true;
+                options.collapse_on_fitted_surface = true;
+                options.smoothing_onto_fitted_surface = true;
+                options.smoothing_iterations = 2;
+            }
             ImproveContext context;
             context.xi = c.xi;
             context.allow_topology_changes = false;
