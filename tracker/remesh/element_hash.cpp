@@ -35,8 +35,8 @@ Box3d edge_box(const SurfaceMesh& mesh, int ei) {
     return b;
 }
 
-void query_periodic(const SpatialHash& hash, const Box3d& stored_bounds,
-                    const MeshPeriods& periods, const Box3d& box, std::vector<int>& out) {
+void query_periodic(const SpatialHash& hash, const Box3d& stored_bounds, const MeshPeriods& periods,
+                    const Box3d& box, std::vector<int>& out) {
     if (!periods.any()) {
         hash.query(box, out);
         return;

@@ -59,7 +59,7 @@ Box3d edge_box(const SurfaceMesh& mesh, int ei);
 /// `hash.query(box, out)` for boxes of a periodic mesh: also looks up every image of `box` by
 /// whole periods along the wrapping axes of `periods` that can overlap `stored_bounds` (a box
 /// holding every stored box); `out` sorted, each id once. Without a wrapping axis, one query.
-void query_periodic(const SpatialHash& hash, const Box3d& stored_bounds,
-                    const MeshPeriods& periods, const Box3d& box, std::vector<int>& out);
+void query_periodic(const SpatialHash& hash, const Box3d& stored_bounds, const MeshPeriods& periods,
+                    const Box3d& box, std::vector<int>& out);
 
 }  // namespace meniscus::tracker

@@ -172,8 +172,7 @@ bool candidate_triangles_intersect(const SurfaceMesh& mesh, const ElementHash& h
     // Periodic meshes: every vertex at its image nearest the first candidate's first corner
     // (one reference, so a vertex two triangles share is the same point in both).
     const bool periodic = mesh.periodic() && !candidates.triangles.empty();
-    const Vec3 reference =
-        periodic ? raw_position(candidates.triangles.front()[0]) : Vec3::Zero();
+    const Vec3 reference = periodic ? raw_position(candidates.triangles.front()[0]) : Vec3::Zero();
     auto position = [&](int vi) -> Vec3 {
         return periodic ? mesh.periods().nearest_image(raw_position(vi), reference)
                         : raw_position(vi);

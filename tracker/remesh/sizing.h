@@ -54,9 +54,9 @@ constexpr double SIZE_GRADING = 0.5;
 /// Edge-length limits for one split or collapse call. On a periodic mesh α is at most the
 /// smallest period over MeshPeriods::PERIOD_TO_EDGE_RATIO (β scaled with it, keeping β/α), so
 /// that remeshing never grows an edge to where the minimum image could be ambiguous; options
-/// and ξ are not changed (remesh_limits() still reports the unclamped values). Curvature and facing distances are
-/// measured when the object is built; vertices created afterwards get the nominal limits
-/// (s = 1) unless inherit() grades them from their split edge's endpoints.
+/// and ξ are not changed (remesh_limits() still reports the unclamped values). Curvature and facing
+/// distances are measured when the object is built; vertices created afterwards get the nominal
+/// limits (s = 1) unless inherit() grades them from their split edge's endpoints.
 class EdgeSizing {
 public:
     /// Throws std::invalid_argument on invalid options or ξ ≤ 0.
