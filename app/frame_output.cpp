@@ -1,6 +1,7 @@
 #include "app/frame_output.h"
 
 #include "app/checkpoint.h"
+#include "app/scene_setup.h"
 
 #include "common/atomic_file.h"
 #include "coupling/periodic_images.h"
@@ -162,6 +163,7 @@ FrameFormat frame_format(const Scene& scene) {
     vdb.length_scale = 1.0 / format.metres_per_unit;
     // /surface/inside names the phase the surface encloses (build_initial_surface's labels).
     vdb.inside_region = scene.surface.inside == "gas" ? 0 : 1;
+    vdb.density_cut = scene_periods(scene);
     return format;
 }
 

@@ -299,17 +299,29 @@ openvdb::FloatGrid::Ptr density_grid(const openvdb::FloatGrid& surface,
     density->setGridClass(openvdb::GRID_FOG_VOLUME);
     density->setTransform(surface.transform().copy());
     const double ramp = options.density_ramp_voxels * options.voxel_size * options.length_scale;
+    // The voxels kept along each axis (VdbOutputOptions::density_cut): voxel i is centred at
+    // i · voxel_size.
+    openvdb::CoordBBox kept(openvdb::Coord::min(), openvdb::Coord::max());
+    for (int a = 0; a < 3; ++a)
+        if (options.density_cut.wraps(a)) {
+            const double lo = options.density_cut.origin[a] / options.voxel_size;
+            const double hi = lo + options.density_cut.length[a] / options.voxel_size;
+            kept.min()[a] = static_cast<openvdb::Int32>(std::ceil(lo));
+            kept.max()[a] = static_cast<openvdb::Int32>(std::ceil(hi)) - 1;
+        }
     auto acc = density->getAccessor();
     for (auto it = surface.cbeginValueAll(); it; ++it) {
         const double phi = *it;
         if (it.isVoxelValue()) {
             const double fog = std::clamp(0.5 - phi / ramp, 0.0, 1.0);
-            if (fog > 0.0)
+            if (fog > 0.0 && kept.isInside(it.getCoord()))
                 acc.setValue(it.getCoord(), static_cast<float>(fog));
         } else if (phi < 0.0) {
             openvdb::CoordBBox box;
             it.getBoundingBox(box);
-            density->fill(box, 1.0f, true);
+            box.intersect(kept);
+            if (!box.empty())
+                density->fill(box, 1.0f, true);
         }
     }
     openvdb::tools::prune(density->tree());

@@ -59,6 +59,11 @@ struct VdbOutputOptions {
     /// The region label (tracker::LabelPair) the surface encloses: `surface` is negative and
     /// `density` 1 there.
     int inside_region = 1;
+    /// A periodic scene's box (issue 39): along each axis with a length > 0 the `density` fog
+    /// holds only the voxels whose centres lie in [origin, origin + length), so that a drop across
+    /// a face of the box shows cut there at both ends and copies of the box tile without doubled
+    /// fog. `surface` keeps its whole band (its distances near a face see the surface beyond it).
+    tracker::MeshPeriods density_cut;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
 

@@ -1,3 +1,4 @@
+#include "coupling/periodic_images.h"
 #include "coupling/vdb_output.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/mesh_measures.h"
@@ -433,6 +434,43 @@ TEST(VdbOutput, FluidFieldsSitOnCellCentresInOutputUnits) {
     EXPECT_EQ(without.count("pressure"), 0u);
     EXPECT_EQ(without.count("surface"), 1u);
     std::filesystem::remove(path);
+}
+
+/// A periodic scene's fog is cut at the box (VdbOutputOptions::density_cut): a sphere across the
+/// x faces of a box periodic along x shows at both ends, cut there, and nowhere beyond; the
+/// surface grid keeps its band beyond the faces. The mesh is given unrolled, as the frame
+/// output gives it.
+TEST(VdbOutput, PeriodicDensityIsCutAtTheBox) {
+    tracker::ImplicitMeshOptions mesh_options;
+    mesh_options.edge_length = 0.02;
+    mesh_options.periods.length.x() = 1.0;
+    // Centred on the face x = 0, with its image at x = 1 (the shape must be periodic): half of
+    // it on each side of the box.
+    std::vector<tracker::ShapePtr> spheres;
+    spheres.push_back(tracker::make_sphere(Eigen::Vector3d(0.0, 0.5, 0.5), 0.2));
+    spheres.push_back(tracker::make_sphere(Eigen::Vector3d(1.0, 0.5, 0.5), 0.2));
+    const tracker::SurfaceMesh periodic =
+        tracker::mesh_implicit_shape(*tracker::make_union(std::move(spheres)), mesh_options);
+    ASSERT_TRUE(periodic.periodic());
+    const double voxel = 0.02;
+    const tracker::SurfaceMesh unrolled = unroll_periodic_mesh(periodic, 5 * voxel).mesh;
+    VdbOutputOptions options;
+    options.voxel_size = voxel;
+    options.density_cut = periodic.periods();
+    auto grids = written_grids(unrolled, options, "periodic_cut");
+    auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(grids.at("density"));
+    auto surface = openvdb::gridPtrCast<openvdb::FloatGrid>(grids.at("surface"));
+    const openvdb::CoordBBox fog = density->evalActiveVoxelBoundingBox();
+    const openvdb::CoordBBox band = surface->evalActiveVoxelBoundingBox();
+    EXPECT_EQ(fog.min().x(), 0);    // voxel centres from x = 0 …
+    EXPECT_EQ(fog.max().x(), 49);   // … to x = 0.98
+    EXPECT_LT(band.min().x(), -5);  // the band reaches past both faces
+    EXPECT_GT(band.max().x(), 55);
+    // Both halves are there: full fog just inside each face, on the sphere's axis.
+    auto acc = density->getConstAccessor();
+    EXPECT_FLOAT_EQ(acc.getValue(openvdb::Coord(0, 25, 25)), 1.0f);
+    EXPECT_FLOAT_EQ(acc.getValue(openvdb::Coord(49, 25, 25)), 1.0f);
+    EXPECT_FLOAT_EQ(acc.getValue(openvdb::Coord(25, 25, 25)), 0.0f);
 }
 
 }  // namespace
