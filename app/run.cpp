@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -420,12 +421,23 @@ void restore_state(const Resume& resume, const RunOptions& options, const Restor
 }
 
 /// A stand-in surface for solvers that a checkpoint's state then replaces (a resumed run does
-/// not mesh its initial shape again).
-SurfaceMesh placeholder_surface() {
-    return SurfaceMesh({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)},
-                       {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}});
+/// not mesh its initial shape again). With `periods` (a periodic scene) it is a small tetrahedron
+/// in the box that wraps as the scene's surface does: its state keeps the periods it is loaded
+/// into (SurfaceMesh::load_state), and the simulation checks them against the box.
+SurfaceMesh placeholder_surface(const tracker::MeshPeriods& periods = {}) {
+    const std::vector<tracker::Triangle> faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    if (!periods.any())
+        return SurfaceMesh({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}, faces);
+    double size = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a)
+        if (periods.wraps(a))
+            size = std::min(size,
+                            periods.length[a] / (4.0 * tracker::MeshPeriods::PERIOD_TO_EDGE_RATIO));
+    const Vec3 o = periods.origin;
+    SurfaceMesh mesh({o, o + Vec3(size, 0, 0), o + Vec3(0, size, 0), o + Vec3(0, 0, size)}, faces);
+    mesh.set_periods(periods);
+    return mesh;
 }
-
 
 /// Runs a fluid scene, keeping `result` current frame by frame (a caller that catches an
 /// exception still knows what was written).
@@ -438,7 +450,8 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
     if (resume) {
         prepare_output_dir(options.out_dir);
         nominal_xi = resume->checkpoint.header.nominal_xi;
-        simulation.emplace(make_fluid_simulation(scene, placeholder_surface(), nominal_xi));
+        simulation.emplace(
+            make_fluid_simulation(scene, placeholder_surface(scene_periods(scene)), nominal_xi));
         restore_state(*resume, options, [&](BinaryReader& in) { simulation->load_state(in); });
         report = "resumed at frame " + std::to_string(resume->checkpoint.header.frame) +
                  " from " + options.out_dir + "/" + CHECKPOINT_NAME;

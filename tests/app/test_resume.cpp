@@ -42,6 +42,22 @@ const char* FLUID_SCENE = R"({
   "time": {"end": 0.004, "frames": 8}
 })";
 
+/// FLUID_SCENE's drops in a box periodic along x, moving apart inside the box and so towards
+/// each other across its x faces, where they meet (issue 39).
+const char* PERIODIC_SCENE = R"({
+  "flow": {"type": "fluid"},
+  "domain": {"min": [0, 0, 0], "size": [0.006, 0.004, 0.004], "cells": 18},
+  "fluid": {"gravity": [0, 0, 0], "boundaries": {"x_min": "periodic", "x_max": "periodic"}},
+  "coupling": {"edge_length_cells": 1.0, "volume_correction": true},
+  "surface": {"shape": {"type": "union", "shapes": [
+    {"type": "sphere", "center": [0.0013, 0.002, 0.002], "radius": 0.001},
+    {"type": "sphere", "center": [0.0047, 0.002, 0.002], "radius": 0.001}]}},
+  "initial_velocity": [
+    {"shape": {"type": "sphere", "center": [0.0013, 0.002, 0.002], "radius": 0.001}, "velocity": [-0.3, 0, 0]},
+    {"shape": {"type": "sphere", "center": [0.0047, 0.002, 0.002], "radius": 0.001}, "velocity": [0.3, 0, 0]}],
+  "time": {"end": 0.004, "frames": 8}
+})";
+
 /// A sphere in the Enright field: remeshing, collisions; about 2 s in Release.
 const char* FLOW_SCENE = R"({
   "flow": {"type": "enright", "period": 3},
@@ -226,6 +242,27 @@ TEST_F(Resume, StoppedRunResumesFromItsLastCheckpoint) {
     ASSERT_TRUE(rest.exited && rest.exit_code == 0) << describe(rest);
     EXPECT_NE(rest.output.find("resumed at frame"), std::string::npos) << rest.output;
     expect_same_frames(reference, stopped);
+}
+
+TEST_F(Resume, PeriodicFluidRunResumesWithTheUninterruptedRunsFrames) {
+    // Regression: a resumed periodic scene failed to set up ("the fluid box is periodic along x
+    // but the surface mesh does not wrap around it"): the stand-in surface the checkpoint's
+    // state replaces had no periods.
+    const std::string scene = write("periodic.json", PERIODIC_SCENE);
+    const fs::path reference = m_dir / "reference", stopped = m_dir / "stopped";
+    ASSERT_EQ(meniscus({"run", scene, "--out", reference.string(), "--quiet"}).exit_code, 0);
+    const ChildResult part =
+        meniscus({"run", scene, "--out", stopped.string(), "--quiet", "--max-steps", "15"});
+    ASSERT_TRUE(part.exited) << describe(part);
+    ASSERT_FALSE(fs::exists(stopped / "surface_0008.ply"));
+    const ChildResult rest = meniscus({"run", "--resume", stopped.string()});
+    ASSERT_TRUE(rest.exited && rest.exit_code == 0) << describe(rest);
+    EXPECT_NE(rest.output.find("resumed at frame"), std::string::npos) << rest.output;
+    expect_same_frames(reference, stopped);
+    // The drops met across the seam: one component at the end.
+    const std::vector<nlohmann::json> lines = stats_without_clock(reference);
+    EXPECT_EQ(lines.front()["components"].get<int>(), 2);
+    EXPECT_EQ(lines.back()["components"].get<int>(), 1);
 }
 
 TEST_F(Resume, TruncatedOrDamagedCheckpointIsRefusedNamingTheFile) {
