@@ -128,7 +128,9 @@ OutputSurface output_surface(const tracker::SurfaceMesh& mesh,
     if (mesh.periodic()) {
         coupling::UnrolledMesh unrolled = coupling::unroll_periodic_mesh(mesh, periodic_margin);
         out.velocities = coupling::unrolled_values(unrolled, out.velocities);
-        out.mesh = std::move(unrolled.mesh);
+        out.mesh = periodic_margin > 0.0
+                       ? std::move(unrolled.mesh)
+                       : coupling::cut_at_box(unrolled.mesh, mesh.periods(), &out.velocities);
     } else {
         out.mesh = mesh;
     }

@@ -46,9 +46,10 @@ std::vector<std::string> remove_frames_after(const std::string& dir, int frame);
 /// mid-pinch, split at their midpoints, singular vertices split into one copy per fan, nothing
 /// moved), so that each edge has exactly two triangles; positions and velocities multiplied by
 /// `length_scale` (output units per metre). The enclosed volume changes by round-off only.
-/// A periodic mesh is written unrolled (coupling/periodic_images.h): every image of each triangle
-/// that reaches into the box grown by `periodic_margin` (m), so the surface covers the box to its
-/// faces; a triangle across a face of the box is there at both of its images.
+/// A periodic mesh is written unrolled (coupling/periodic_images.h): with `periodic_margin` 0 (the
+/// PLY and OBJ) its images in the box, cut exactly at the box's faces along the periodic axes
+/// (open there: copies of the box tile into the whole surface); with a margin (m, for the VDB's
+/// distances) every image of each triangle reaching into the box grown by it, uncut.
 struct OutputSurface {
     tracker::SurfaceMesh mesh;
     std::vector<tracker::Vec3> velocities;  ///< per vertex of `mesh`, output units per second

@@ -86,4 +86,105 @@ UnrolledMesh unroll_periodic_mesh(const tracker::SurfaceMesh& mesh, double margi
     return out;
 }
 
+namespace {
+
+/// One pass of cut_at_box(): keeps the side where `inside(p)` ≥ 0 (an affine function).
+struct PlaneCut {
+    int axis;
+    double plane;
+    double sign;  // +1 keeps x_axis ≥ plane, −1 keeps x_axis ≤ plane
+    double inside(const Vec3& p) const { return sign * (p[axis] - plane); }
+};
+
+void cut_once(std::vector<Vec3>& positions, std::vector<tracker::Triangle>& triangles,
+              std::vector<tracker::LabelPair>& labels, std::vector<Vec3>* values,
+              const PlaneCut& cut) {
+    std::vector<double> d(positions.size());
+    for (size_t v = 0; v < positions.size(); ++v)
+        d[v] = cut.inside(positions[v]);
+    std::unordered_map<std::int64_t, int> crossing;  // edge (lo, hi) → its new vertex
+    const auto split = [&](int a, int b) {
+        const int lo = std::min(a, b), hi = std::max(a, b);
+        const std::int64_t key =
+            static_cast<std::int64_t>(lo) << 32 | static_cast<std::uint32_t>(hi);
+        const auto [it, added] = crossing.emplace(key, static_cast<int>(positions.size()));
+        if (added) {
+            // From the lower index, so both triangles on the edge get the same point.
+            const double t = d[static_cast<size_t>(lo)] /
+                             (d[static_cast<size_t>(lo)] - d[static_cast<size_t>(hi)]);
+            positions.push_back(
+                positions[static_cast<size_t>(lo)] +
+                t * (positions[static_cast<size_t>(hi)] - positions[static_cast<size_t>(lo)]));
+            positions.back()[cut.axis] = cut.plane;  // exactly on the face
+            if (values)
+                values->push_back(
+                    (*values)[static_cast<size_t>(lo)] +
+                    t * ((*values)[static_cast<size_t>(hi)] - (*values)[static_cast<size_t>(lo)]));
+        }
+        return it->second;
+    };
+    std::vector<tracker::Triangle> kept;
+    std::vector<tracker::LabelPair> kept_labels;
+    for (size_t ti = 0; ti < triangles.size(); ++ti) {
+        const tracker::Triangle& t = triangles[ti];
+        std::array<int, 4> polygon{};
+        int n = 0;
+        for (int k = 0; k < 3; ++k) {
+            const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
+            const double da = d[static_cast<size_t>(a)], db = d[static_cast<size_t>(b)];
+            if (da >= 0.0)
+                polygon[static_cast<size_t>(n++)] = a;
+            if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0))
+                polygon[static_cast<size_t>(n++)] = split(a, b);
+        }
+        for (int k = 1; k + 1 < n; ++k) {  // a fan keeps the orientation
+            kept.push_back(
+                {polygon[0], polygon[static_cast<size_t>(k)], polygon[static_cast<size_t>(k + 1)]});
+            kept_labels.push_back(labels[ti]);
+        }
+    }
+    triangles.swap(kept);
+    labels.swap(kept_labels);
+}
+
+}  // namespace
+
+tracker::SurfaceMesh cut_at_box(const tracker::SurfaceMesh& mesh,
+                                const tracker::MeshPeriods& periods,
+                                std::vector<tracker::Vec3>* values) {
+    if (values && values->size() != static_cast<size_t>(mesh.num_vertices()))
+        throw std::invalid_argument("cut_at_box: values must be sized num_vertices()");
+    std::vector<Vec3> positions = mesh.positions();
+    std::vector<tracker::Triangle> triangles;
+    std::vector<tracker::LabelPair> labels;
+    for (int ti = 0; ti < mesh.num_triangles(); ++ti)
+        if (mesh.triangle_alive(ti)) {
+            triangles.push_back(mesh.triangle(ti));
+            labels.push_back(mesh.labels(ti));
+        }
+    for (int a = 0; a < 3; ++a)
+        if (periods.wraps(a)) {
+            cut_once(positions, triangles, labels, values, {a, periods.origin[a], 1.0});
+            cut_once(positions, triangles, labels, values,
+                     {a, periods.origin[a] + periods.length[a], -1.0});
+        }
+    // Vertices no triangle uses any more (beyond the faces) are dropped.
+    std::vector<int> map(positions.size(), tracker::INVALID_INDEX);
+    std::vector<Vec3> used, used_values;
+    for (tracker::Triangle& t : triangles)
+        for (int& v : t) {
+            int& m = map[static_cast<size_t>(v)];
+            if (m == tracker::INVALID_INDEX) {
+                m = static_cast<int>(used.size());
+                used.push_back(positions[static_cast<size_t>(v)]);
+                if (values)
+                    used_values.push_back((*values)[static_cast<size_t>(v)]);
+            }
+            v = m;
+        }
+    if (values)
+        values->swap(used_values);
+    return tracker::SurfaceMesh(std::move(used), triangles, labels);
+}
+
 }  // namespace meniscus::coupling

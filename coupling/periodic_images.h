@@ -27,6 +27,17 @@ struct UnrolledMesh {
 /// std::invalid_argument on a negative or non-finite margin.
 UnrolledMesh unroll_periodic_mesh(const tracker::SurfaceMesh& mesh, double margin);
 
+/// `mesh` (an unrolled mesh) cut at the faces of the fundamental box of `periods` along each axis
+/// that wraps: triangles beyond a face are removed and those across it cut along it, each crossing
+/// edge getting one new vertex that the triangles on both of its sides share. The surface ends
+/// open exactly at the faces, where the box's copies continue it (what a renderer tiles).
+/// `values` (optional, one per vertex of `mesh`) are interpolated linearly along the cut edges and
+/// come back one per vertex of the result. A triangle the cut leaves a quadrilateral of becomes
+/// two; orientation and labels are kept.
+tracker::SurfaceMesh cut_at_box(const tracker::SurfaceMesh& mesh,
+                                const tracker::MeshPeriods& periods,
+                                std::vector<tracker::Vec3>* values = nullptr);
+
 /// Per vertex of `unrolled`, the value the periodic mesh's source vertex has in `values`.
 template <typename T>
 std::vector<T> unrolled_values(const UnrolledMesh& unrolled, const std::vector<T>& values) {
