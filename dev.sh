@@ -34,7 +34,7 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-exitcode=86:detect_leaks=1:strict_string_che
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-exitcode=86:print_stacktrace=1}
 PACKAGES=(cmake ninja-build g++ ccache libeigen3-dev libtbb-dev libopenvdb-dev libboost-iostreams-dev
           nlohmann-json3-dev libgtest-dev libbenchmark-dev libgmp-dev python3-matplotlib python3-numpy
-          blender python3-openvdb python3-meshio python3-pil)
+          blender python3-openvdb python3-meshio python3-pil libhypre-dev libopenmpi-dev)
 
 install_missing() {
   local missing=()
