@@ -32,9 +32,11 @@ SANITIZE_EXCLUDE+='|Resume\.(FluidRunKilled|GeometricFlowKilled|OneAndTwoThreads
 # Any finding ends the program with exit code 86 (tests then fail); LeakSanitizer included.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-exitcode=86:detect_leaks=1:strict_string_checks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-exitcode=86:print_stacktrace=1}
+# Open MPI's own leaks at MPI_Init/MPI_Finalize (the hypre pressure solver), and only those.
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tests/lsan_suppressions.txt}
 PACKAGES=(cmake ninja-build g++ ccache libeigen3-dev libtbb-dev libopenvdb-dev libboost-iostreams-dev
           nlohmann-json3-dev libgtest-dev libbenchmark-dev libgmp-dev python3-matplotlib python3-numpy
-          blender python3-openvdb python3-meshio python3-pil)
+          blender python3-openvdb python3-meshio python3-pil libhypre-dev libopenmpi-dev)
 
 install_missing() {
   local missing=()

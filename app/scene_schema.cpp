@@ -139,8 +139,10 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
     enum_field(v, "pressure_solver", o.pressure.solver,
                {{"multigrid_pcg", fluid::PressureSolver::multigrid_pcg},
                 {"mic0_pcg", fluid::PressureSolver::mic0_pcg},
-                {"eigen_ic_cg", fluid::PressureSolver::eigen_ic_cg}},
-               "pressure Poisson solver");
+                {"eigen_ic_cg", fluid::PressureSolver::eigen_ic_cg},
+                {"hypre_pfmg_pcg", fluid::PressureSolver::hypre_pfmg_pcg}},
+               "pressure Poisson solver (hypre_pfmg_pcg: hypre's PCG with a PFMG V-cycle, on one "
+               "MPI process)");
     v.number("pressure_tolerance", o.pressure.iteration.tolerance, Range{0.0, 1.0, true, true}, "",
              "relative residual of the pressure solve");
     v.integer("pressure_max_iterations", o.pressure.iteration.max_iterations,

@@ -3,9 +3,13 @@
 // each PCG iteration moves next to the machine's memory bandwidth.
 //
 // Run: bench_pressure [--benchmark_filter=...]; MENISCUS_BENCH_CELLS=<n> changes the grid size.
+// The `_1thread` / `_2threads` cases cap TBB's parallelism (hypre itself is sequential here: one
+// MPI process, Debian's libHYPRE built without OpenMP); their setup_s is the preconditioner's
+// set-up (for hypre: grid, matrix copy and the PCG/PFMG set-up), included in the solve time.
 #include <benchmark/benchmark.h>
 
 #include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include <chrono>
@@ -99,11 +103,19 @@ double bytes_per_iteration(PressureSolver solver, std::size_t cells) {
             return (PCG_CORE_DOUBLES + MULTIGRID_DOUBLES) * BYTES_PER_DOUBLE * cells;
         case PressureSolver::eigen_ic_cg:
             return EIGEN_IC_CG_BYTES * cells;
+        case PressureSolver::hypre_pfmg_pcg:
+            return 0.0;  // no traffic model for hypre's kernels
     }
     return 0.0;
 }
 
-void BM_PressureSolve(benchmark::State& state, PressureSolver solver, int max_iterations) {
+/// `threads` > 0 caps TBB's parallelism for the whole case (0: TBB's default).
+void BM_PressureSolve(benchmark::State& state, PressureSolver solver, int max_iterations,
+                      int threads = 0) {
+    std::unique_ptr<tbb::global_control> cap;
+    if (threads > 0)
+        cap = std::make_unique<tbb::global_control>(
+            tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
     const PressureSystem& system = bubble_system();
     PressureOptions options;
     options.solver = solver;
@@ -127,6 +139,10 @@ void BM_PressureSolve(benchmark::State& state, PressureSolver solver, int max_it
         setup_seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         state.counters["levels"] = setup.levels();
+    } else if (solver == PressureSolver::hypre_pfmg_pcg) {
+        const meniscus::fluid::HyprePressureSolver setup(system.matrix, system.singular);
+        setup_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
     const double bytes = bytes_per_iteration(solver, system.matrix.size());
     state.counters["cells"] = static_cast<double>(system.matrix.size());
@@ -185,6 +201,23 @@ BENCHMARK_CAPTURE(BM_PressureSolve, multigrid_pcg, PressureSolver::multigrid_pcg
     ->UseRealTime()
     ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_PressureSolve, eigen_ic_cg, PressureSolver::eigen_ic_cg, MAX_ITERATIONS)
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kSecond);
+// hypre PFMG-PCG against our multigrid PCG on one rank: one thread each, and the multigrid
+// also on two (its V-cycle and vector kernels are TBB-parallel).
+BENCHMARK_CAPTURE(BM_PressureSolve, hypre_pfmg_pcg_1thread, PressureSolver::hypre_pfmg_pcg,
+                  MAX_ITERATIONS, 1)
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_PressureSolve, multigrid_pcg_1thread, PressureSolver::multigrid_pcg,
+                  MAX_ITERATIONS, 1)
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_PressureSolve, multigrid_pcg_2threads, PressureSolver::multigrid_pcg,
+                  MAX_ITERATIONS, 2)
     ->Iterations(1)
     ->UseRealTime()
     ->Unit(benchmark::kSecond);

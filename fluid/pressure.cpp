@@ -146,7 +146,7 @@ void for_each_outflow_face(const MacGrid& grid, const InterfaceInput& interface,
 void PressureOptions::validate() const {
     iteration.validate();
     if (solver != PressureSolver::mic0_pcg && solver != PressureSolver::multigrid_pcg &&
-        solver != PressureSolver::eigen_ic_cg) {
+        solver != PressureSolver::eigen_ic_cg && solver != PressureSolver::hypre_pfmg_pcg) {
         throw std::invalid_argument("PressureOptions.solver: unknown solver");
     }
     if (!(min_liquid_fraction > 0.0 && min_liquid_fraction <= 1.0)) {
@@ -246,6 +246,12 @@ PressureSystemSolver::PressureSystemSolver(const PressureSystem& system,
             break;
         case PressureSolver::eigen_ic_cg:
             break;
+        case PressureSolver::hypre_pfmg_pcg: {
+            auto hypre = std::make_unique<HyprePressureSolver>(system.matrix, system.singular);
+            m_hypre = hypre.get();
+            m_preconditioner = std::move(hypre);
+            break;
+        }
     }
 }
 
@@ -260,7 +266,8 @@ SolveResult PressureSystemSolver::solve(const std::vector<double>& rhs,
                                     std::to_string(a.size()) + " cells");
     std::vector<double> solution;
     const SolveResult result =
-        m_preconditioner
+        m_hypre ? m_hypre->solve(rhs, m_options.iteration, solution)
+        : m_preconditioner
             ? solve_pcg(a, rhs, *m_preconditioner, m_options.iteration, m_system.singular, solution)
             : solve_eigen_ic_cg(a, rhs, m_options.iteration, m_system.singular, solution);
     pressure.resize(a.ni(), a.nj(), a.nk(), 0.0);

@@ -27,6 +27,7 @@
 #include "common/phase_clock.h"
 #include "fluid/array3.h"
 #include "fluid/boundary.h"
+#include "fluid/hypre_pressure.h"
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
 #include "fluid/mic0.h"
@@ -41,7 +42,10 @@ namespace meniscus::fluid {
 enum class PressureSolver {
     mic0_pcg,       ///< PCG with the MIC(0) preconditioner (sequential preconditioner)
     multigrid_pcg,  ///< PCG with a multigrid V-cycle preconditioner (TBB-parallel)
-    eigen_ic_cg     ///< reference: Eigen ConjugateGradient + IncompleteCholesky on a CSR copy
+    eigen_ic_cg,    ///< reference: Eigen ConjugateGradient + IncompleteCholesky on a CSR copy
+    /// hypre (libhypre-dev) on one MPI process: HYPRE_StructPCG preconditioned by one
+    /// HYPRE_StructPFMG V-cycle (fluid/hypre_pressure.h; initialises MPI on first use)
+    hypre_pfmg_pcg
 };
 
 /// Options of the pressure projection.
@@ -93,13 +97,17 @@ public:
     /// Solves A p = rhs (`rhs` sized like the system; its own right-hand side is not used).
     SolveResult solve(const std::vector<double>& rhs, Array3<double>& pressure) const;
     /// p = M⁻¹ rhs, one application of the preconditioner (rhs projected to zero mean first
-    /// when the system is singular, p then too); a full solve() for eigen_ic_cg, which has none.
+    /// when the system is singular, p then too): a MIC(0) or multigrid application, one PFMG
+    /// V-cycle for hypre_pfmg_pcg (hypre's own preconditioner); a full solve() for eigen_ic_cg,
+    /// which has none.
     SolveResult precondition(const std::vector<double>& rhs, Array3<double>& pressure) const;
 
 private:
     const PressureSystem& m_system;
     PressureOptions m_options;
-    std::unique_ptr<Preconditioner> m_preconditioner;  ///< null for eigen_ic_cg
+    /// null for eigen_ic_cg; for hypre_pfmg_pcg the HyprePressureSolver (one PFMG V-cycle)
+    std::unique_ptr<Preconditioner> m_preconditioner;
+    const HyprePressureSolver* m_hypre = nullptr;  ///< m_preconditioner's, for hypre_pfmg_pcg
 };
 
 /// u ← u − Δt/ρ_f ∇p on every face adjacent to an unknown cell (ghost-fluid gradients with the σκ
