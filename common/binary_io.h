@@ -136,6 +136,8 @@ private:
     void copy_out(void* out, std::size_t size) {
         if (size > remaining())
             throw FormatError("the data ends early");
+        if (size == 0)  // an empty vector's data() may be null, and memcpy must not see null
+            return;
         std::memcpy(out, m_data + m_pos, size);
         m_pos += size;
     }
