@@ -247,7 +247,8 @@ TEST_P(FluidPressureSolverTest, AllLiquidClosedBoxIsAConsistentSingularSystem) {
 
 INSTANTIATE_TEST_SUITE_P(AllBackends, FluidPressureSolverTest,
                          ::testing::Values(PressureSolver::mic0_pcg, PressureSolver::multigrid_pcg,
-                                           PressureSolver::eigen_ic_cg),
+                                           PressureSolver::eigen_ic_cg,
+                                           PressureSolver::hypre_pfmg_pcg),
                          [](const ::testing::TestParamInfo<PressureSolver>& param_info) {
                              switch (param_info.param) {
                                  case PressureSolver::mic0_pcg:
@@ -256,6 +257,8 @@ INSTANTIATE_TEST_SUITE_P(AllBackends, FluidPressureSolverTest,
                                      return std::string("multigrid_pcg");
                                  case PressureSolver::eigen_ic_cg:
                                      return std::string("eigen_ic_cg");
+                                 case PressureSolver::hypre_pfmg_pcg:
+                                     return std::string("hypre_pfmg_pcg");
                              }
                              return std::string("unknown");
                          });

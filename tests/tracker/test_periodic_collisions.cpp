@@ -278,8 +278,9 @@ TEST(PeriodicCollisions, ColumnsDrivenIntoEachOtherAcrossTheSeamStayApart) {
             proximities += r.collisions.proximities;
             collisions += r.collisions.collisions_first_sweep;
             intersecting = std::max(intersecting, r.intersecting_pairs);
-            if (safe)
+            if (safe) {
                 ASSERT_EQ(r.intersecting_pairs, 0) << "step " << step;
+            }
         }
         const SurfaceMesh& m = tracker.mesh();
         for (int v = 0; v < m.num_vertices(); ++v) {

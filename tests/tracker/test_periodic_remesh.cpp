@@ -119,8 +119,9 @@ void expect_valid_periodic(const SurfaceMesh& mesh, double max_edge, const std::
     EXPECT_TRUE(violations.empty()) << what << ": " << violations.size() << " violations, first "
                                     << (violations.empty() ? "" : violations[0].message);
     for (int ei = 0; ei < mesh.num_edges(); ++ei)
-        if (mesh.edge_alive(ei))
+        if (mesh.edge_alive(ei)) {
             EXPECT_EQ(mesh.edge_triangles(ei).size(), 2u) << what << ": edge " << ei;
+        }
     for (int ti = 0; ti < mesh.num_triangles(); ++ti) {
         if (!mesh.triangle_alive(ti))
             continue;
@@ -347,8 +348,9 @@ TEST(PeriodicLocalSafety, APseudoMotionThroughTheSeamHitsTheTriangleOnTheOtherSi
         EXPECT_EQ(pseudo_motion_collides(mesh, hash, motion), periodic) << periodic;
         // The same end given at its wrapped image: the same motion.
         motion.x_t1 = {Vec3(0.02, 0.02, 0.95)};
-        if (periodic)
+        if (periodic) {
             EXPECT_TRUE(pseudo_motion_collides(mesh, hash, motion));
+        }
         // A short motion that stays clear of T1.
         motion.x_t1 = {Vec3(0.02, 0.02, 0.0)};
         EXPECT_FALSE(pseudo_motion_collides(mesh, hash, motion)) << periodic;
@@ -449,10 +451,12 @@ TEST(PeriodicImprove, TubeStaysAValidIntersectionFreeTubeOfTheSameVolume) {
             EXPECT_NEAR(volume_along(mesh, 1), v1, 1e-12) << what;
             EXPECT_LT(max_radius_error(mesh, radius), 0.03) << what;
             EXPECT_EQ(counter.bad_parameters, 0) << what;
-            if (c.seam_splits)
+            if (c.seam_splits) {
                 EXPECT_GT(counter.seam_splits, 0) << what;
-            if (c.seam_collapses)
+            }
+            if (c.seam_collapses) {
                 EXPECT_GT(counter.seam_collapses, 0) << what;
+            }
             std::cout << what << ": " << mesh.count_live_vertices() << " vertices, splits "
                       << counter.splits << " (" << counter.seam_splits << " across the seam), "
                       << "collapses " << counter.collapses << " (" << counter.seam_collapses
