@@ -93,6 +93,11 @@ protected:
         return run_child(args, limits, (m_dir / "log.txt").string(), while_running);
     }
 
+    /// Runs `scene` whole into reference/, and into stopped/ stopped by --max-steps
+    /// `max_steps` (as Ctrl-C does) before its last frame, then resumed: stopped/ must end with
+    /// reference/'s frames.
+    void expect_stopped_run_resumes(const std::string& scene, const std::string& max_steps);
+
     fs::path m_dir;
 };
 
@@ -148,6 +153,19 @@ void expect_same_frames(const fs::path& expected, const fs::path& actual) {
     ASSERT_EQ(a.size(), b.size());
     for (size_t i = 0; i < a.size(); ++i)
         EXPECT_EQ(a[i], b[i]) << "stats.jsonl line " << i + 1;
+}
+
+void Resume::expect_stopped_run_resumes(const std::string& scene, const std::string& max_steps) {
+    const fs::path reference = m_dir / "reference", stopped = m_dir / "stopped";
+    ASSERT_EQ(meniscus({"run", scene, "--out", reference.string(), "--quiet"}).exit_code, 0);
+    const ChildResult part =
+        meniscus({"run", scene, "--out", stopped.string(), "--quiet", "--max-steps", max_steps});
+    ASSERT_TRUE(part.exited) << describe(part);
+    ASSERT_FALSE(fs::exists(stopped / "surface_0008.ply"));
+    const ChildResult rest = meniscus({"run", "--resume", stopped.string()});
+    ASSERT_TRUE(rest.exited && rest.exit_code == 0) << describe(rest);
+    EXPECT_NE(rest.output.find("resumed at frame"), std::string::npos) << rest.output;
+    expect_same_frames(reference, stopped);
 }
 
 /// Complete lines in `dir`/stats.jsonl (frames done).
@@ -231,36 +249,16 @@ TEST_F(Resume, GeometricFlowKilledAtRandomMomentsEndsWithTheUninterruptedRunsFra
 
 TEST_F(Resume, StoppedRunResumesFromItsLastCheckpoint) {
     // --max-steps stops a run part way (as Ctrl-C does); --resume finishes it.
-    const std::string scene = write("enright.json", FLOW_SCENE);
-    const fs::path reference = m_dir / "reference", stopped = m_dir / "stopped";
-    ASSERT_EQ(meniscus({"run", scene, "--out", reference.string(), "--quiet"}).exit_code, 0);
-    const ChildResult part =
-        meniscus({"run", scene, "--out", stopped.string(), "--quiet", "--max-steps", "13"});
-    ASSERT_TRUE(part.exited) << describe(part);
-    ASSERT_FALSE(fs::exists(stopped / "surface_0008.ply"));
-    const ChildResult rest = meniscus({"run", "--resume", stopped.string()});
-    ASSERT_TRUE(rest.exited && rest.exit_code == 0) << describe(rest);
-    EXPECT_NE(rest.output.find("resumed at frame"), std::string::npos) << rest.output;
-    expect_same_frames(reference, stopped);
+    expect_stopped_run_resumes(write("enright.json", FLOW_SCENE), "13");
 }
 
 TEST_F(Resume, PeriodicFluidRunResumesWithTheUninterruptedRunsFrames) {
     // Regression: a resumed periodic scene failed to set up ("the fluid box is periodic along x
     // but the surface mesh does not wrap around it"): the stand-in surface the checkpoint's
     // state replaces had no periods.
-    const std::string scene = write("periodic.json", PERIODIC_SCENE);
-    const fs::path reference = m_dir / "reference", stopped = m_dir / "stopped";
-    ASSERT_EQ(meniscus({"run", scene, "--out", reference.string(), "--quiet"}).exit_code, 0);
-    const ChildResult part =
-        meniscus({"run", scene, "--out", stopped.string(), "--quiet", "--max-steps", "15"});
-    ASSERT_TRUE(part.exited) << describe(part);
-    ASSERT_FALSE(fs::exists(stopped / "surface_0008.ply"));
-    const ChildResult rest = meniscus({"run", "--resume", stopped.string()});
-    ASSERT_TRUE(rest.exited && rest.exit_code == 0) << describe(rest);
-    EXPECT_NE(rest.output.find("resumed at frame"), std::string::npos) << rest.output;
-    expect_same_frames(reference, stopped);
+    expect_stopped_run_resumes(write("periodic.json", PERIODIC_SCENE), "15");
     // The drops met across the seam: one component at the end.
-    const std::vector<nlohmann::json> lines = stats_without_clock(reference);
+    const std::vector<nlohmann::json> lines = stats_without_clock(m_dir / "reference");
     EXPECT_EQ(lines.front()["components"].get<int>(), 2);
     EXPECT_EQ(lines.back()["components"].get<int>(), 1);
 }
