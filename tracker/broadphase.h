@@ -1,13 +1,10 @@
 #pragma once
 /// \file Broad phase: which mesh elements may interact, from axis-aligned boxes (paper §4.5).
 ///
-/// `SpatialHash` stores boxes of one element type in a uniform grid hashed by cell; a box
-/// query returns every stored element whose box overlaps the query box — exactly the brute
-/// force answer, never fewer (every pair of overlapping boxes shares at least one cell, and the
-/// final filter is an exact box-overlap test). Elements can be inserted, removed and updated,
-/// so remeshing can keep it current.
+/// `LooseGrid` holds a static set of boxes for bulk queries and self joins; the dynamic
+/// `SpatialHash` that remeshing keeps current is in spatial_hash.h.
 ///
-/// `BroadPhase` holds one hash per element type (vertices, edges, triangles) for a mesh whose
+/// `BroadPhase` holds one grid per element type (vertices, edges, triangles) for a mesh whose
 /// vertices move linearly from x_t0 to x_t1 (swept boxes; static when x_t0 = x_t1) and
 /// enumerates candidate pairs for CCD, proximity and intersection tests.
 ///
@@ -25,6 +22,7 @@
 /// always took (one branch).
 
 #include "tracker/mesh.h"
+#include "tracker/spatial_hash.h"
 
 #include <Eigen/Geometry>
 
@@ -34,55 +32,6 @@
 #include <vector>
 
 namespace meniscus::tracker {
-
-using Box3d = Eigen::AlignedBox3d;
-
-/// Dynamic uniform-grid hash of boxes keyed by element index. Flat storage: an open-addressing
-/// table of cells whose lists are linked entries in one pool.
-class SpatialHash {
-public:
-    /// `cell_size` (> 0, metres) should be near the typical box extent. Throws otherwise.
-    explicit SpatialHash(double cell_size = 1.0);
-    /// Inserts or replaces element `id`'s box (id ≥ 0).
-    void insert(int id, const Box3d& box);
-    /// Removes element `id` (no-op if absent).
-    void remove(int id);
-    /// Replaces `out` with every element whose box overlaps `box` (closed boxes), each once,
-    /// sorted. Safe to call from several threads at once (no mutation).
-    void query(const Box3d& box, std::vector<int>& out) const;
-    bool contains(int id) const;
-    const Box3d& box(int id) const { return m_boxes[static_cast<size_t>(id)]; }
-    double cell_size() const { return m_cell; }
-    void clear();
-
-private:
-    struct CellRange {
-        Eigen::Array3i lo, hi;
-        bool oversized = false;
-    };
-    CellRange cells_of(const Box3d& box) const;
-    static std::int64_t key(int i, int j, int k);
-    /// Slot of `key` in the open-addressing table, or −1 when absent.
-    int find_slot(std::int64_t key) const;
-    /// Slot of `key`, added (with an empty list) when absent; may grow the table.
-    int find_or_add_slot(std::int64_t key);
-    void grow();
-
-    double m_cell;
-    // Flat hash of cells (open addressing, linear probing; keys stay once added, with possibly
-    // empty lists, until clear()): per slot the cell key (−1 = free) and the head of its list.
-    std::vector<std::int64_t> m_slot_key;
-    std::vector<int> m_slot_head;
-    size_t m_used_slots = 0;
-    // Cell lists as singly linked entries in one pool, with a free list (no allocation per
-    // cell or per insert once the pool has grown).
-    std::vector<int> m_entry_id, m_entry_next;
-    int m_free_entry = -1;
-    std::vector<int> m_oversized;  // boxes spanning too many cells, checked on every query
-    std::vector<Box3d> m_boxes;
-    std::vector<CellRange> m_ranges;
-    std::vector<std::uint8_t> m_present;
-};
 
 /// A vertex and a triangle that does not contain it.
 struct VertexTrianglePair {
