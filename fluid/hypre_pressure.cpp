@@ -16,32 +16,6 @@ namespace meniscus::fluid {
 
 namespace {
 
-/// hypre keeps process-wide state (its error flag, its memory and MPI bookkeeping) and is not
-/// built thread-safe: every call into it, from set-up to destruction, holds this lock. MPI is
-/// initialised with MPI_THREAD_SERIALIZED to match (any thread, one at a time).
-std::mutex& hypre_lock() {
-    static std::mutex lock;
-    return lock;
-}
-
-/// True when a launcher started this process as one rank of a job (Open MPI's mpirun sets
-/// OMPI_COMM_WORLD_SIZE, PMIx launchers PMIX_RANK, MPICH/Hydra and Slurm PMI_RANK / PMI_SIZE).
-bool launched_by_mpi_launcher() {
-    for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
-        if (std::getenv(name) != nullptr)
-            return true;
-    return false;
-}
-
-void finalize_mpi_at_exit() {
-    std::lock_guard<std::mutex> guard(hypre_lock());
-    HYPRE_Finalize();
-    int finalized = 0;
-    MPI_Finalized(&finalized);
-    if (!finalized)
-        MPI_Finalize();
-}
-
 void check(HYPRE_Int error, const char* call) {
     if (error == 0)
         return;
@@ -63,71 +37,35 @@ constexpr std::array<std::array<HYPRE_Int, 3>, STENCIL_SIZE> STENCIL_OFFSETS = {
 
 }  // namespace
 
-// MPI for a plain run (no mpirun), measured on Debian 12 with Open MPI 4.1.4, as root:
-//
-// - Open MPI refuses root only in its launcher (mpirun/orterun need --allow-run-as-root or
-//   OMPI_ALLOW_RUN_AS_ROOT=1 + OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1). A process that calls
-//   MPI_Init_thread without a launcher is a "singleton" and starts fine as root with no
-//   variables set.
-// - But by default the singleton forks a helper daemon (`orted --hnp`), in case it later calls
-//   MPI_Comm_spawn: a second process per run, sockets, ~0.3 s, and where the parent is killed or
-//   PID 1 does not reap (containers) a zombie orted is left behind (seen here). We never spawn, so
-//   a singleton is made *isolated* (OMPI_MCA_ess_singleton_isolated=1): no daemon.
-// - One process only talks to itself: the point-to-point layer is pinned to ob1 over the `self`
-//   transport (OMPI_MCA_pml=ob1, OMPI_MCA_btl=self). Without this Open MPI probes UCX, openib,
-//   libfabric and shared memory at every start (0.28 s → 0.04 s for MPI_Init_thread here) and
-//   the shared-memory transport would create a segment file.
-// - Open MPI installs handlers for SIGSEGV/SIGBUS/SIGFPE/SIGABRT that print its own backtrace;
-//   OMPI_MCA_opal_signal="" keeps the program's (and the sanitizers') handling of those signals.
-// All are set with setenv(..., overwrite = 0), so a user's own OMPI_MCA_* settings win, and only
-// when no MPI launcher started the process (under mpirun the launcher's set-up is left alone).
-// MPI_Finalize runs from std::atexit, after HYPRE_Finalize; a hypre object still alive then (a
-// solver in a static object destroyed after the exit handlers) would be destroyed after
-// MPI_Finalize, so none should outlive main().
-void ensure_mpi_initialized() {
+// hypre keeps process-wide state (its error flag, its memory and MPI bookkeeping) and is not built
+// thread-safe: every call into it, from set-up to destruction, holds mpi_lock() (hypre calls MPI).
+// HYPRE_Finalize is registered with std::atexit after MPI's own handler, so it runs before
+// MPI_Finalize; a hypre object still alive then (a solver in a static object destroyed after the
+// exit handlers) would be destroyed after MPI_Finalize, so none should outlive main().
+void ensure_hypre_initialized() {
     static std::once_flag once;
     std::call_once(once, [] {
-        int initialized = 0;
-        MPI_Initialized(&initialized);
-        int finalized = 0;
-        MPI_Finalized(&finalized);
-        if (finalized)
-            throw std::runtime_error("hypre pressure solver: MPI has already been finalised");
-        if (!initialized) {
-            if (!launched_by_mpi_launcher()) {
-                setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
-                setenv("OMPI_MCA_pml", "ob1", 0);
-                setenv("OMPI_MCA_btl", "self", 0);
-                setenv("OMPI_MCA_opal_signal", "", 0);
-            }
-            int provided = 0;
-            if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided) !=
-                MPI_SUCCESS)
-                throw std::runtime_error("hypre pressure solver: MPI_Init_thread failed");
-            if (provided < MPI_THREAD_SERIALIZED)
-                throw std::runtime_error(
-                    "hypre pressure solver: MPI does not provide MPI_THREAD_SERIALIZED");
-        }
+        ensure_mpi_initialized();
         {
-            std::lock_guard<std::mutex> guard(hypre_lock());
+            std::lock_guard<std::mutex> guard(mpi_lock());
             check(HYPRE_Init(), "HYPRE_Init");
         }
-        // Finalise only what we initialised: an MPI someone else started is theirs to end, but
-        // hypre's own state is ours either way.
-        if (!initialized)
-            std::atexit(finalize_mpi_at_exit);
-        else
-            std::atexit([] {
-                std::lock_guard<std::mutex> guard(hypre_lock());
-                HYPRE_Finalize();
-            });
+        std::atexit([] {
+            std::lock_guard<std::mutex> guard(mpi_lock());
+            HYPRE_Finalize();
+        });
     });
 }
 
 struct HyprePressureSolver::State {
-    int ni = 0, nj = 0, nk = 0;
+    int ni = 0, nj = 0;
+    int local_k = 0;  ///< z-layers of the caller's vectors (the block)
+    int k_begin = 0;  ///< the block's layer of the first owned layer
+    int owned_k = 0;  ///< owned z-layers
     bool singular = false;
-    std::vector<char> active;  ///< per cell: diagonal > 0
+    RankCommunicator ranks = RankCommunicator::self();
+    std::vector<char> active;      ///< per owned cell: diagonal > 0
+    std::size_t active_cells = 0;  ///< over every rank
     HYPRE_StructGrid grid = nullptr;
     HYPRE_StructStencil stencil = nullptr;
     HYPRE_StructMatrix matrix = nullptr;
@@ -135,7 +73,7 @@ struct HyprePressureSolver::State {
     HYPRE_StructVector x = nullptr;
     HYPRE_StructSolver pcg = nullptr;
     HYPRE_StructSolver pfmg = nullptr;
-    std::array<HYPRE_Int, 3> lower = {0, 0, 0};
+    std::array<HYPRE_Int, 3> lower = {0, 0, 0};  ///< the owned box, global indices
     std::array<HYPRE_Int, 3> upper = {0, 0, 0};
 
     ~State() {
@@ -157,56 +95,116 @@ struct HyprePressureSolver::State {
         HYPRE_ClearAllErrors();
     }
 
-    /// Copies `values` (our layout, inactive entries zeroed) into the hypre vector `v`.
+    std::size_t local_size() const { return static_cast<std::size_t>(ni) * nj * local_k; }
+    /// Offset of the first owned cell in the caller's (block) vectors.
+    std::size_t owned_offset() const { return static_cast<std::size_t>(ni) * nj * k_begin; }
+
+    /// Copies the owned part of `values` (the block's layout; inactive entries zeroed) into the
+    /// hypre vector `v`.
     void set_vector(HYPRE_StructVector v, const std::vector<double>& values) {
-        std::vector<double> copy(values.size());
-        for (std::size_t c = 0; c < values.size(); ++c)
-            copy[c] = active[c] ? values[c] : 0.0;
+        std::vector<double> copy(active.size());
+        const std::size_t offset = owned_offset();
+        for (std::size_t c = 0; c < copy.size(); ++c)
+            copy[c] = active[c] ? values[offset + c] : 0.0;
         check(HYPRE_StructVectorSetBoxValues(v, lower.data(), upper.data(), copy.data()),
               "HYPRE_StructVectorSetBoxValues");
         check(HYPRE_StructVectorAssemble(v), "HYPRE_StructVectorAssemble");
     }
+    /// The owned part of `v` into `values` (the block's layout, resized; zero elsewhere).
     void get_vector(HYPRE_StructVector v, std::vector<double>& values) const {
-        values.assign(active.size(), 0.0);
+        std::vector<double> owned(active.size(), 0.0);
         check(HYPRE_StructVectorGetBoxValues(v, const_cast<HYPRE_Int*>(lower.data()),
-                                             const_cast<HYPRE_Int*>(upper.data()), values.data()),
+                                             const_cast<HYPRE_Int*>(upper.data()), owned.data()),
               "HYPRE_StructVectorGetBoxValues");
-        for (std::size_t c = 0; c < values.size(); ++c)
-            if (!active[c])
-                values[c] = 0.0;
+        values.assign(local_size(), 0.0);
+        const std::size_t offset = owned_offset();
+        for (std::size_t c = 0; c < owned.size(); ++c)
+            values[offset + c] = active[c] ? owned[c] : 0.0;
+    }
+    /// Subtracts the mean over the active owned cells of every rank from those of `v` (block
+    /// layout).
+    void remove_mean(std::vector<double>& v) const {
+        if (active_cells == 0)
+            return;
+        const std::size_t offset = owned_offset();
+        double sum = 0.0;
+        for (std::size_t c = 0; c < active.size(); ++c)
+            sum += active[c] ? v[offset + c] : 0.0;
+        const double mean = ranks.sum(sum) / static_cast<double>(active_cells);
+        for (std::size_t c = 0; c < active.size(); ++c)
+            if (active[c])
+                v[offset + c] -= mean;
     }
 };
 
 HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular)
+    : HyprePressureSolver(a, singular, SlabDecomposition(std::max(a.nk(), 1)),
+                          RankCommunicator::self()) {}
+
+HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular,
+                                         const SlabDecomposition& decomposition,
+                                         const RankCommunicator& ranks)
     : m_state(std::make_unique<State>()) {
     if (a.size() == 0)
         throw std::invalid_argument("HyprePressureSolver: empty matrix");
-    ensure_mpi_initialized();
-    std::lock_guard<std::mutex> guard(hypre_lock());
+    const int rank = ranks.rank();
+    if (decomposition.ranks() != ranks.size())
+        throw std::invalid_argument("HyprePressureSolver: a decomposition over " +
+                                    std::to_string(decomposition.ranks()) + " ranks on " +
+                                    std::to_string(ranks.size()));
+    if (a.nk() != decomposition.local_layers(rank))
+        throw std::invalid_argument(
+            "HyprePressureSolver: the matrix has " + std::to_string(a.nk()) + " z-layers, rank " +
+            std::to_string(rank) + "'s block " + std::to_string(decomposition.local_layers(rank)));
+    const bool distributed = decomposition.distributed();
+    if (distributed && decomposition.ghost_layers() < 1)
+        throw std::invalid_argument(
+            "HyprePressureSolver: a distributed system needs at least one ghost layer");
+    if (distributed && a.periodic[2])
+        throw std::invalid_argument(
+            "HyprePressureSolver: a rank's block does not wrap along z (the decomposition does)");
+    ensure_hypre_initialized();
     State& s = *m_state;
     s.ni = a.ni();
     s.nj = a.nj();
-    s.nk = a.nk();
+    s.local_k = a.nk();
+    s.k_begin = decomposition.owned_begin(rank) - decomposition.local_begin(rank);
+    s.owned_k = decomposition.owned_end(rank) - decomposition.owned_begin(rank);
     s.singular = singular;
-    s.upper = {s.ni - 1, s.nj - 1, s.nk - 1};
-    s.active.resize(a.size());
-    for (std::size_t c = 0; c < a.size(); ++c)
-        s.active[c] = a.diag[c] > 0.0 ? 1 : 0;
-    const std::array<int, 3> n = {s.ni, s.nj, s.nk};
+    s.ranks = ranks;
+    s.lower = {0, 0, decomposition.owned_begin(rank)};
+    s.upper = {s.ni - 1, s.nj - 1, decomposition.owned_end(rank) - 1};
+    const std::size_t layer = static_cast<std::size_t>(s.ni) * s.nj;
+    s.active.resize(layer * s.owned_k);
+    std::size_t active_here = 0;
+    for (std::size_t c = 0; c < s.active.size(); ++c) {
+        s.active[c] = a.diag[s.owned_offset() + c] > 0.0 ? 1 : 0;
+        active_here += s.active[c];
+    }
+    s.active_cells = static_cast<std::size_t>(ranks.sum(static_cast<double>(active_here)));
+    // Every call into hypre from here on holds the lock (the sum above took it itself).
+    std::lock_guard<std::mutex> guard(mpi_lock());
+    // The global grid's extents (x, y as the block's; z the decomposition's).
+    const std::array<int, 3> n = {s.ni, s.nj, decomposition.layers()};
+    const std::array<int, 3> local_n = {s.ni, s.nj, s.local_k};
 
     // One process: every rank (if several run this) solves the whole system on its own.
-    const MPI_Comm comm = MPI_COMM_SELF;
+    const MPI_Comm comm = ranks.is_world() ? MPI_COMM_WORLD : MPI_COMM_SELF;
     check(HYPRE_StructGridCreate(comm, 3, &s.grid), "HYPRE_StructGridCreate");
     check(HYPRE_StructGridSetExtents(s.grid, s.lower.data(), s.upper.data()),
           "HYPRE_StructGridSetExtents");
     // A periodic axis wraps the grid itself: the stencil entry of the last cell towards +axis
     // (index n) then reads cell 0, and that of cell 0 towards −axis reads cell n−1. Along an axis
-    // of one cell PoissonMatrix has no seam coupling (the cell would neighbour itself).
+    // of one cell PoissonMatrix has no seam coupling (the cell would neighbour itself). A
+    // distributed z wraps through the ghost layers of the block instead (the block's matrix holds
+    // the seam's couplings like any other).
     std::array<HYPRE_Int, 3> periods = {0, 0, 0};
     std::array<bool, 3> wraps = {false, false, false};
     for (std::size_t axis = 0; axis < 3; ++axis) {
         wraps[axis] = a.periodic[axis] && n[axis] > 1;
-        periods[axis] = wraps[axis] ? n[axis] : 0;
+        const bool global_wrap =
+            axis == 2 && distributed ? decomposition.periodic() && n[axis] > 1 : wraps[axis];
+        periods[axis] = global_wrap ? n[axis] : 0;
     }
     check(HYPRE_StructGridSetPeriodic(s.grid, periods.data()), "HYPRE_StructGridSetPeriodic");
     check(HYPRE_StructGridAssemble(s.grid), "HYPRE_StructGridAssemble");
@@ -222,14 +220,15 @@ HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular)
     check(HYPRE_StructMatrixInitialize(s.matrix), "HYPRE_StructMatrixInitialize");
 
     // hypre's stencil entries are the matrix coefficients themselves, as PoissonMatrix::apply()
-    // uses them: y_c = diag_c x_c + Σ off(c, nb) x_nb, off ≤ 0. One z-slab at a time (7 doubles
-    // per cell of the slab).
+    // uses them: y_c = diag_c x_c + Σ off(c, nb) x_nb, off ≤ 0. One owned z-layer at a time
+    // (7 doubles per cell of the layer), read from the block's matrix, whose ghost layers give
+    // the couplings to the neighbouring ranks' cells.
     std::array<HYPRE_Int, STENCIL_SIZE> entries{};
     for (int e = 0; e < STENCIL_SIZE; ++e)
         entries[static_cast<std::size_t>(e)] = e;
-    std::vector<double> values(static_cast<std::size_t>(STENCIL_SIZE) * s.ni * s.nj);
+    std::vector<double> values(static_cast<std::size_t>(STENCIL_SIZE) * layer);
     const auto is_active = [&](int i, int j, int k) { return a.diag(i, j, k) > 0.0; };
-    for (int k = 0; k < s.nk; ++k) {
+    for (int k = s.k_begin; k < s.k_begin + s.owned_k; ++k) {
         std::size_t v = 0;
         for (int j = 0; j < s.nj; ++j)
             for (int i = 0; i < s.ni; ++i) {
@@ -252,10 +251,10 @@ HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular)
                     if (cell[ax] > 0)
                         lo[ax] = cell[ax] - 1;
                     else if (wraps[ax])
-                        lo[ax] = n[ax] - 1;
+                        lo[ax] = local_n[ax] - 1;
                     else
                         has_lo = false;
-                    if (cell[ax] + 1 < n[ax])
+                    if (cell[ax] + 1 < local_n[ax])
                         hi[ax] = cell[ax] + 1;
                     else if (wraps[ax])
                         hi[ax] = 0;
@@ -268,7 +267,9 @@ HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular)
                         has_hi && is_active(hi[0], hi[1], hi[2]) ? off(i, j, k) : 0.0;
                 }
             }
-        std::array<HYPRE_Int, 3> slab_lower = {0, 0, k}, slab_upper = {s.ni - 1, s.nj - 1, k};
+        const int global_k = s.lower[2] + (k - s.k_begin);
+        std::array<HYPRE_Int, 3> slab_lower = {0, 0, global_k},
+                                 slab_upper = {s.ni - 1, s.nj - 1, global_k};
         check(HYPRE_StructMatrixSetBoxValues(s.matrix, slab_lower.data(), slab_upper.data(),
                                              STENCIL_SIZE, entries.data(), values.data()),
               "HYPRE_StructMatrixSetBoxValues");
@@ -279,7 +280,7 @@ HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular)
     check(HYPRE_StructVectorInitialize(s.b), "HYPRE_StructVectorInitialize");
     check(HYPRE_StructVectorCreate(comm, s.grid, &s.x), "HYPRE_StructVectorCreate");
     check(HYPRE_StructVectorInitialize(s.x), "HYPRE_StructVectorInitialize");
-    const std::vector<double> zero(a.size(), 0.0);
+    const std::vector<double> zero(s.local_size(), 0.0);
     s.set_vector(s.b, zero);
     s.set_vector(s.x, zero);
 
@@ -322,7 +323,7 @@ HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular)
 }
 
 HyprePressureSolver::~HyprePressureSolver() {
-    std::lock_guard<std::mutex> guard(hypre_lock());
+    std::lock_guard<std::mutex> guard(mpi_lock());
     m_state.reset();
 }
 
@@ -331,33 +332,21 @@ SolveResult HyprePressureSolver::solve(const std::vector<double>& rhs,
                                        std::vector<double>& x) const {
     options.validate();
     State& s = *m_state;
-    if (rhs.size() != s.active.size())
+    if (rhs.size() != s.local_size())
         throw std::invalid_argument("HyprePressureSolver::solve: right-hand side of " +
                                     std::to_string(rhs.size()) + " values for " +
-                                    std::to_string(s.active.size()) + " cells");
+                                    std::to_string(s.local_size()) + " cells");
     options.cancel.throw_if_requested("the hypre PCG solve");
-    std::vector<double> b(rhs.size());
-    std::size_t active_cells = 0;
-    for (std::size_t c = 0; c < b.size(); ++c) {
-        b[c] = s.active[c] ? rhs[c] : 0.0;
-        active_cells += s.active[c] ? 1 : 0;
-    }
-    const auto remove_mean = [&](std::vector<double>& v) {
-        if (active_cells == 0)
-            return;
-        double sum = 0.0;
-        for (std::size_t c = 0; c < v.size(); ++c)
-            sum += s.active[c] ? v[c] : 0.0;
-        const double mean = sum / static_cast<double>(active_cells);
-        for (std::size_t c = 0; c < v.size(); ++c)
-            if (s.active[c])
-                v[c] -= mean;
-    };
+    std::vector<double> b(rhs.size(), 0.0);
+    const std::size_t offset = s.owned_offset();
+    for (std::size_t c = 0; c < s.active.size(); ++c)
+        b[offset + c] = s.active[c] ? rhs[offset + c] : 0.0;
     if (s.singular)
-        remove_mean(b);
+        s.remove_mean(b);
     double b_norm_squared = 0.0;
     for (double value : b)
         b_norm_squared += value * value;
+    b_norm_squared = s.ranks.sum(b_norm_squared);
     SolveResult result;
     if (b_norm_squared == 0.0) {
         x.assign(b.size(), 0.0);
@@ -365,7 +354,7 @@ SolveResult HyprePressureSolver::solve(const std::vector<double>& rhs,
         return result;
     }
     {
-        std::lock_guard<std::mutex> guard(hypre_lock());
+        std::lock_guard<std::mutex> guard(mpi_lock());
         s.set_vector(s.b, b);
         s.set_vector(s.x, std::vector<double>(b.size(), 0.0));
         check(HYPRE_StructPCGSetTol(s.pcg, options.tolerance), "HYPRE_StructPCGSetTol");
@@ -384,18 +373,18 @@ SolveResult HyprePressureSolver::solve(const std::vector<double>& rhs,
         result.converged = std::isfinite(residual) && residual <= options.tolerance;
     }
     if (s.singular)
-        remove_mean(x);
+        s.remove_mean(x);
     options.cancel.throw_if_requested("the hypre PCG solve");
     return result;
 }
 
 void HyprePressureSolver::apply(const std::vector<double>& r, std::vector<double>& z) const {
     State& s = *m_state;
-    if (r.size() != s.active.size())
+    if (r.size() != s.local_size())
         throw std::invalid_argument("HyprePressureSolver::apply: vector of " +
                                     std::to_string(r.size()) + " values for " +
-                                    std::to_string(s.active.size()) + " cells");
-    std::lock_guard<std::mutex> guard(hypre_lock());
+                                    std::to_string(s.local_size()) + " cells");
+    std::lock_guard<std::mutex> guard(mpi_lock());
     s.set_vector(s.b, r);
     s.set_vector(s.x, std::vector<double>(r.size(), 0.0));
     // The PFMG object was set up for this matrix by HYPRE_StructPCGSetup; zero guess, one cycle.

@@ -1,7 +1,9 @@
 #pragma once
 /// \file The pressure Poisson system solved by hypre (Debian libhypre-dev) through its
 /// structured-grid interface: PCG (HYPRE_StructPCG) preconditioned by one PFMG V-cycle
-/// (HYPRE_StructPFMG), on one MPI process (MPI_COMM_SELF: no domain decomposition yet).
+/// (HYPRE_StructPFMG), on one process (MPI_COMM_SELF) or on the ranks of a distributed run, each
+/// holding its slab of z-layers (slab_decomposition.h) as one box of a HYPRE_StructGrid on
+/// MPI_COMM_WORLD.
 ///
 /// The PoissonMatrix becomes a 7-point variable-coefficient HYPRE_StructMatrix with the same
 /// entries (hypre stores matrix coefficients as they are: the positive diagonal, the off-diagonals
@@ -13,6 +15,11 @@
 /// does (hypre's PCG itself does not project its residuals; the projected right-hand side lies in
 /// the range of A, so it converges to a solution, which may carry a constant, removed after).
 ///
+/// Distributed, each rank passes the matrix it assembled on its block of the grid (its slab and
+/// ghost layers, on which the rows of its own cells are exactly the global system's) and hypre
+/// takes the rows of the owned layers; vectors are the block's, of which only the owned layers are
+/// read and written.
+///
 /// Neither MPI nor hypre appears in this header: both are private to meniscus::fluid.
 
 #include <memory>
@@ -20,16 +27,16 @@
 
 #include "fluid/pcg.h"
 #include "fluid/poisson_matrix.h"
+#include "fluid/rank_communicator.h"
+#include "fluid/slab_decomposition.h"
 #include "fluid/solve_result.h"
 
 namespace meniscus::fluid {
 
-/// Initialises MPI (once per process, thread-safe) if nobody has, for a plain run without mpirun,
-/// and hypre (HYPRE_Init); registers MPI_Finalize (after HYPRE_Finalize) with std::atexit. When
-/// MPI was initialised by someone else it is left to them. Called by HyprePressureSolver; callable
-/// directly. Throws std::runtime_error if MPI was already finalised or MPI_Init_thread fails.
-/// See hypre_pressure.cpp for what it sets up for a plain run as root and why.
-void ensure_mpi_initialized();
+/// Initialises MPI (ensure_mpi_initialized()) and hypre (HYPRE_Init) once per process, and
+/// registers HYPRE_Finalize with std::atexit (it runs before MPI_Finalize). Called by
+/// HyprePressureSolver; callable directly. Throws std::runtime_error when MPI or hypre fails.
+void ensure_hypre_initialized();
 
 /// A PoissonMatrix set up once in hypre (grid, matrix, PFMG hierarchy), then solved for any
 /// number of right-hand sides. Keeps no reference to the matrix. All calls into hypre are
@@ -40,9 +47,16 @@ void ensure_mpi_initialized();
 /// Gauss–Seidel, one sweep before and after, Galerkin coarse operators).
 class HyprePressureSolver final : public Preconditioner {
 public:
-    /// `singular`: A is pure Neumann (null space = the constant over active cells).
+    /// One process. `singular`: A is pure Neumann (null space = the constant over active cells).
     /// Throws std::invalid_argument for an empty matrix, std::runtime_error when hypre fails.
     HyprePressureSolver(const PoissonMatrix& matrix, bool singular);
+    /// Collective over `ranks` (every rank constructs its own, with the same `decomposition` of
+    /// the grid's z-layers over ranks.size() ranks): `block` is this rank's block of the system,
+    /// decomposition.local_layers(rank) z-layers, non-periodic along z when the decomposition is
+    /// distributed (the decomposition wraps instead), with at least one ghost layer. `singular`
+    /// as above, for the global system. Throws std::invalid_argument when the sizes do not fit.
+    HyprePressureSolver(const PoissonMatrix& block, bool singular,
+                        const SlabDecomposition& decomposition, const RankCommunicator& ranks);
     ~HyprePressureSolver() override;
     HyprePressureSolver(const HyprePressureSolver&) = delete;
     HyprePressureSolver& operator=(const HyprePressureSolver&) = delete;
@@ -52,7 +66,8 @@ public:
     /// updated residual, as solve_pcg), at most options.max_iterations. Same conventions as
     /// solve_pcg: b's inactive entries are ignored, x (resized) is zero on inactive cells, the
     /// returned residual is relative to the (projected) b. options.cancel is checked before and
-    /// after the solve only (hypre's iterations cannot be interrupted).
+    /// after the solve only (hypre's iterations cannot be interrupted). Distributed: collective;
+    /// b and x are the block's, x zero outside the owned layers (halo_exchange.h fills them).
     SolveResult solve(const std::vector<double>& b, const IterativeSolverOptions& options,
                       std::vector<double>& x) const;
 

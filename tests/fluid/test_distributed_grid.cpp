@@ -1,0 +1,248 @@
+// The grid split over MPI ranks (issue 40): halo exchange, assembly of the whole field and the
+// ghost-fluid projection solved by hypre with every rank holding its slab, against the whole
+// grid's projection on one process. The suite runs this program three ways: on its own (one rank
+// of MPI_COMM_WORLD), and under `mpirun -n 2` and `-n 3` (tests/fluid/CMakeLists.txt). Every rank
+// builds the same whole problem deterministically and checks its own block against it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "fluid/distributed_projection.h"
+#include "fluid/grid_block.h"
+#include "fluid/halo_exchange.h"
+#include "fluid/rank_communicator.h"
+#include "fluid/slab_decomposition.h"
+
+namespace meniscus::fluid {
+namespace {
+
+constexpr double DX = 1e-3;  // m
+constexpr double DT = 1e-3;  // s
+constexpr double TOL = 1e-10;
+/// Allowed max |p_ranks − p_whole| and |u_ranks − u_whole| over their scales: two solutions of
+/// relative residual ≤ TOL differ by about cond(A)·TOL; a missing coupling between ranks, a
+/// ghost layer not refreshed or a rank's rows taken from the wrong layer give O(1) differences.
+constexpr double AGREEMENT = 1e-6;
+
+RankCommunicator ranks() {
+    return RankCommunicator::world();
+}
+
+/// A value unique to each element, so a layer copied from the wrong place shows.
+double label(int i, int j, int k) {
+    return 1e4 * k + 1e2 * j + i + 0.25;
+}
+
+Array3<double> labelled(int ni, int nj, int nk) {
+    Array3<double> a(ni, nj, nk);
+    for (int k = 0; k < nk; ++k)
+        for (int j = 0; j < nj; ++j)
+            for (int i = 0; i < ni; ++i)
+                a(i, j, k) = label(i, j, k);
+    return a;
+}
+
+TEST(RankCommunicator, WorldSumsAndExchanges) {
+    const RankCommunicator world = ranks();
+    const int n = world.size();
+    EXPECT_EQ(world.sum(world.rank() + 1.0), n * (n + 1) / 2.0);
+    EXPECT_EQ(world.max(static_cast<double>(world.rank())), n - 1.0);
+    EXPECT_TRUE(world.all(true));
+    EXPECT_FALSE(world.all(world.rank() != 0));
+    // Rank r sends r·100 + d, d + 1 values, to rank d.
+    std::vector<std::vector<double>> sends(static_cast<std::size_t>(n));
+    for (int d = 0; d < n; ++d)
+        sends[static_cast<std::size_t>(d)].assign(static_cast<std::size_t>(d) + 1,
+                                                  100.0 * world.rank() + d);
+    const std::vector<std::vector<double>> received = world.exchange(sends);
+    ASSERT_EQ(received.size(), static_cast<std::size_t>(n));
+    for (int s = 0; s < n; ++s) {
+        const std::vector<double>& from = received[static_cast<std::size_t>(s)];
+        EXPECT_EQ(from.size(), static_cast<std::size_t>(world.rank()) + 1);
+        for (double v : from)
+            EXPECT_EQ(v, 100.0 * s + world.rank());
+    }
+}
+
+struct HaloCase {
+    int nz, ghosts;
+    bool periodic;
+    LayerKind kind;
+};
+
+TEST(HaloExchange, GhostLayersHoldTheirOwnersValues) {
+    const RankCommunicator world = ranks();
+    for (const HaloCase c :
+         {HaloCase{11, 2, false, LayerKind::cells}, HaloCase{11, 2, false, LayerKind::z_faces},
+          HaloCase{10, 3, true, LayerKind::cells}, HaloCase{10, 3, true, LayerKind::z_faces},
+          HaloCase{9, 1, true, LayerKind::z_faces}}) {
+        const SlabDecomposition d(c.nz, world.size(), c.ghosts, c.periodic);
+        Array3<double> whole = labelled(5, 4, c.nz + (c.kind == LayerKind::z_faces ? 1 : 0));
+        if (c.periodic && c.kind == LayerKind::z_faces)  // face nz is face 0
+            for (int j = 0; j < 4; ++j)
+                for (int i = 0; i < 5; ++i)
+                    whole(i, j, c.nz) = whole(i, j, 0);
+        const Array3<double> expected = extract_block(whole, d, world.rank(), c.kind);
+        // Only the owned layers are known before the exchange.
+        Array3<double> block = expected;
+        const int begin = d.owned_begin(world.rank()) - d.local_begin(world.rank());
+        const int end = d.owned_end(world.rank()) - d.local_begin(world.rank());
+        for (int k = 0; k < block.nk(); ++k)
+            if ((k < begin || k >= end) && d.distributed())
+                for (int j = 0; j < 4; ++j)
+                    for (int i = 0; i < 5; ++i)
+                        block(i, j, k) = std::numeric_limits<double>::quiet_NaN();
+        const bool top_face =
+            c.kind == LayerKind::z_faces && !c.periodic && world.rank() == world.size() - 1;
+        if (top_face)  // the last rank owns the top face of a non-periodic grid
+            for (int j = 0; j < 4; ++j)
+                for (int i = 0; i < 5; ++i)
+                    block(i, j, block.nk() - 1) = expected(i, j, block.nk() - 1);
+        exchange_halos(block, d, world, c.kind);
+        int wrong = 0;
+        for (std::size_t e = 0; e < block.size(); ++e)
+            wrong += block[e] == expected[e] ? 0 : 1;
+        EXPECT_EQ(wrong, 0) << "nz " << c.nz << ", ghosts " << c.ghosts
+                            << (c.periodic ? ", periodic" : "") << ", rank " << world.rank();
+
+        const Array3<double> gathered = gather_field(block, d, world, c.kind, 0);
+        if (world.rank() == 0) {
+            ASSERT_EQ(gathered.size(), whole.size());
+            EXPECT_EQ(gathered.storage(), whole.storage());
+        } else {
+            EXPECT_EQ(gathered.size(), 0u);
+        }
+    }
+}
+
+PhaseOptions water_and_air() {
+    PhaseOptions phases;
+    phases.rho_liquid = 1000.0;
+    phases.rho_gas = 1.0;
+    phases.sigma = 0.072;
+    return phases;
+}
+
+/// A smooth velocity field that is far from divergence-free, the same on every rank.
+void stir(MacGrid& grid) {
+    for (int axis = 0; axis < 3; ++axis) {
+        Array3<double>& u = grid.velocity(axis);
+        for (int k = 0; k < u.nk(); ++k)
+            for (int j = 0; j < u.nj(); ++j)
+                for (int i = 0; i < u.ni(); ++i) {
+                    const Eigen::Vector3d x = grid.face_centre(axis, i, j, k) / (4.0 * DX);
+                    u(i, j, k) = 0.01 * std::sin(1.3 * x.x() + axis) * std::cos(0.7 * x.y()) *
+                                 std::sin(0.9 * x.z() + 0.4 * axis);
+                }
+    }
+}
+
+struct ProjectionCase {
+    const char* name;
+    FluidMode mode;
+    bool periodic_z;
+    bool outflow_top;
+    bool drop;  ///< a liquid drop in gas; otherwise a gas bubble in liquid
+};
+
+/// The whole grid projected on one process (multigrid PCG) against the ranks' blocks projected
+/// together (hypre), block by block.
+void expect_projection_matches(const ProjectionCase& c) {
+    const RankCommunicator world = ranks();
+    const int nx = 10, ny = 9, nz = 14;
+    BoundaryOptions boundaries = BoundaryOptions::all(BoundaryType::free_slip);
+    if (c.periodic_z)
+        boundaries.z_min.type = boundaries.z_max.type = BoundaryType::periodic;
+    if (c.outflow_top)
+        boundaries.z_max.type = BoundaryType::outflow;
+    MacGrid whole(nx, ny, nz, DX);
+    whole.set_periodic({false, false, c.periodic_z});
+    stir(whole);
+    apply_boundary_velocity(whole, boundaries);
+    InterfaceInput interface(whole);
+    const Eigen::Vector3d centre(5.2 * DX, 4.4 * DX, 6.3 * DX);
+    const double radius = 3.1 * DX;
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                const double d = (whole.cell_centre(i, j, k) - centre).norm() - radius;
+                interface.phi(i, j, k) = c.drop ? d : -d;
+            }
+    for (int axis = 0; axis < 3; ++axis)
+        interface.kappa(axis).fill(c.drop ? 2.0 / radius : -2.0 / radius);
+    const PhaseOptions phases = water_and_air();
+    PressureOptions options;
+    options.iteration.tolerance = TOL;
+    options.iteration.max_iterations = 2000;
+
+    MacGrid reference = whole;
+    Array3<double> p_whole;
+    const ProjectionResult serial =
+        project(reference, interface, phases, c.mode, DT, options, p_whole, boundaries);
+    ASSERT_TRUE(serial.solve.converged) << c.name;
+
+    const SlabDecomposition d(nz, world.size(), 2, c.periodic_z);
+    const int rank = world.rank();
+    MacGrid block = extract_block_grid(whole, d, rank);
+    const InterfaceInput block_interface = extract_block_interface(interface, d, rank);
+    options.solver = PressureSolver::hypre_pfmg_pcg;
+    Array3<double> p_block;
+    const ProjectionResult distributed = project_block(block, block_interface, phases, c.mode, DT,
+                                                       options, p_block, boundaries, d, world);
+    EXPECT_TRUE(distributed.solve.converged) << c.name;
+    EXPECT_EQ(distributed.singular, serial.singular) << c.name;
+    EXPECT_LT(distributed.max_divergence, 1e-6 * 0.01 / DX) << c.name;
+
+    // The block, ghost layers included, against the same layers of the whole grid.
+    const Array3<double> p_expected = extract_block(p_whole, d, rank, LayerKind::cells);
+    double p_scale = 0.0, p_difference = 0.0;
+    for (std::size_t e = 0; e < p_expected.size(); ++e) {
+        p_scale = std::max(p_scale, std::abs(p_expected[e]));
+        p_difference = std::max(p_difference, std::abs(p_block[e] - p_expected[e]));
+    }
+    EXPECT_LE(p_difference, AGREEMENT * p_scale) << c.name << ", rank " << rank;
+    const MacGrid expected = extract_block_grid(reference, d, rank);
+    double u_scale = 0.0, u_difference = 0.0;
+    for (int axis = 0; axis < 3; ++axis)
+        for (std::size_t e = 0; e < expected.velocity(axis).size(); ++e) {
+            u_scale = std::max(u_scale, std::abs(expected.velocity(axis)[e]));
+            u_difference = std::max(u_difference,
+                                    std::abs(block.velocity(axis)[e] - expected.velocity(axis)[e]));
+        }
+    EXPECT_LE(u_difference, AGREEMENT * u_scale) << c.name << ", rank " << rank;
+
+    // The velocities gathered on rank 0 are the whole grid's.
+    MacGrid gathered(nx, ny, nz, DX);
+    gather_velocities(block, d, world, gathered, 0);
+    if (rank == 0) {
+        for (int axis = 0; axis < 3; ++axis)
+            for (std::size_t e = 0; e < gathered.velocity(axis).size(); ++e)
+                ASSERT_NEAR(gathered.velocity(axis)[e], reference.velocity(axis)[e],
+                            AGREEMENT * u_scale)
+                    << c.name << ", component " << axis;
+    }
+}
+
+TEST(DistributedProjection, BubbleAtDensityRatio1000InAClosedBox) {
+    expect_projection_matches({"closed box", FluidMode::two_phase, false, false, false});
+}
+
+TEST(DistributedProjection, DropAcrossAPeriodicSeam) {
+    expect_projection_matches({"periodic z", FluidMode::two_phase, true, false, true});
+}
+
+TEST(DistributedProjection, BubbleBelowAnOutflow) {
+    expect_projection_matches({"outflow", FluidMode::two_phase, false, true, false});
+}
+
+TEST(DistributedProjection, FreeSurfaceDrop) {
+    expect_projection_matches({"free surface", FluidMode::free_surface, false, false, true});
+}
+
+}  // namespace
+}  // namespace meniscus::fluid
