@@ -10,6 +10,7 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "fluid/multigrid.h"
@@ -610,6 +611,11 @@ struct OperatorKey {
 /// Work arrays kept between ViscositySolver::solve calls.
 struct ViscositySolver::Workspace {
     ViscousOperator op;
+    /// distribute(): the grid is this rank's block (one rank: a plain solve)
+    SlabDecomposition decomposition;
+    RankCommunicator ranks = RankCommunicator::self();
+    std::vector<char> owned;  ///< distributed: 1 on the entries of [u | v | w] this rank owns
+    std::array<Array3<double>, 3> halo;  ///< distributed: scratch for the halo exchange
     OperatorKey key;  ///< what `op` and `diagonal` were built from (empty φ: nothing yet)
     std::vector<double> u_star, fixed, x, b, r, z, p, q, diagonal;
     /// multigrid: the component blocks and their V-cycles (built on first use after `op`).
@@ -622,6 +628,20 @@ ViscositySolver::ViscositySolver() : m_workspace(std::make_unique<Workspace>()) 
 ViscositySolver::~ViscositySolver() = default;
 ViscositySolver::ViscositySolver(ViscositySolver&&) noexcept = default;
 ViscositySolver& ViscositySolver::operator=(ViscositySolver&&) noexcept = default;
+
+void ViscositySolver::distribute(const SlabDecomposition& decomposition,
+                                 const RankCommunicator& ranks) {
+    if (decomposition.ranks() != ranks.size())
+        throw std::invalid_argument("ViscositySolver::distribute: a decomposition over " +
+                                    std::to_string(decomposition.ranks()) + " ranks on " +
+                                    std::to_string(ranks.size()));
+    if (decomposition.distributed() && decomposition.ghost_layers() < 2)
+        throw std::invalid_argument(
+            "ViscositySolver::distribute: the viscous stencil needs at least 2 ghost layers");
+    m_workspace->decomposition = decomposition;
+    m_workspace->ranks = ranks;
+    m_workspace->owned.clear();
+}
 
 SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interface,
                                    const PhaseOptions& phases, FluidMode mode,
@@ -665,6 +685,67 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     const std::vector<char>& unknown = op.unknown();
     const std::vector<double>& density = op.density();
     const std::size_t n = op.size();
+    // Distributed (the grid is this rank's block): each rank solves for the faces it owns. Dot
+    // products sum its own entries over the ranks; the operator reads the ghost layers of its
+    // argument, so the search direction's are exchanged before each application (the operator's
+    // reach is one cell and one edge: two ghost layers suffice).
+    const bool distributed = ws.decomposition.distributed();
+    if (distributed) {
+        if (ws.decomposition.local_layers(ws.ranks.rank()) != grid.nz())
+            throw std::invalid_argument(
+                "ViscositySolver: the grid is not this rank's block of the decomposition");
+        if (surface)
+            throw std::invalid_argument(
+                "ViscositySolver: semi-implicit surface tension is not available on several "
+                "ranks yet");
+        if (options.preconditioner != ViscousPreconditioner::jacobi)
+            throw std::invalid_argument(
+                "ViscosityOptions.preconditioner: only jacobi is available on several ranks");
+        if (ws.owned.size() != n) {
+            ws.owned.assign(n, 0);
+            const int rank = ws.ranks.rank();
+            const int begin =
+                ws.decomposition.owned_begin(rank) - ws.decomposition.local_begin(rank);
+            const int end = ws.decomposition.owned_end(rank) - ws.decomposition.local_begin(rank);
+            std::size_t offset = 0;
+            for (int a = 0; a < 3; ++a) {
+                const Array3<double>& faces = grid.velocity(a);
+                const std::size_t layer = static_cast<std::size_t>(faces.ni()) * faces.nj();
+                // The last rank of a walled z also owns the top z-face.
+                const bool top =
+                    a == 2 && !ws.decomposition.periodic() && rank == ws.decomposition.ranks() - 1;
+                for (int k = 0; k < faces.nk(); ++k)
+                    if ((k >= begin && k < end) || (top && k == faces.nk() - 1))
+                        std::fill_n(
+                            ws.owned.begin() + static_cast<std::ptrdiff_t>(offset + layer * k),
+                            layer, 1);
+                offset += faces.size();
+            }
+        }
+    }
+    const auto global_dot = [&](const std::vector<double>& a, const std::vector<double>& c) {
+        if (!distributed)
+            return dot(a, c);
+        double sum = 0.0;
+        for (std::size_t f = 0; f < n; ++f)
+            sum += ws.owned[f] ? a[f] * c[f] : 0.0;
+        return ws.ranks.sum(sum);
+    };
+    const auto refresh_ghosts = [&](std::vector<double>& v) {
+        if (!distributed)
+            return;
+        std::size_t offset = 0;
+        for (int a = 0; a < 3; ++a) {
+            const Array3<double>& faces = grid.velocity(a);
+            Array3<double>& h = ws.halo[static_cast<std::size_t>(a)];
+            h.resize(faces.ni(), faces.nj(), faces.nk());
+            std::copy_n(v.begin() + static_cast<std::ptrdiff_t>(offset), faces.size(), h.data());
+            exchange_halos(h, ws.decomposition, ws.ranks,
+                           a == 2 ? LayerKind::z_faces : LayerKind::cells);
+            std::copy_n(h.data(), faces.size(), v.begin() + static_cast<std::ptrdiff_t>(offset));
+            offset += faces.size();
+        }
+    };
     std::vector<double>& x = ws.x;
     std::vector<double>& fixed = ws.fixed;
     std::vector<double>& b = ws.b;
@@ -680,7 +761,7 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     for (std::size_t f = 0; f < n; ++f) {
         b[f] = unknown[f] ? density[f] * ws.u_star[f] - b[f] : 0.0;
     }
-    const double b_norm = std::sqrt(dot(b, b));
+    const double b_norm = std::sqrt(global_dot(b, b));
     if (b_norm == 0.0) {
         x.assign(n, 0.0);
         result.converged = true;
@@ -726,13 +807,14 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
             r[f] = b[f] - q[f];
         precondition();
         p = z;
-        double rz = dot(r, z);
-        result.residual = std::sqrt(dot(r, r)) / b_norm;
+        double rz = global_dot(r, z);
+        result.residual = std::sqrt(global_dot(r, r)) / b_norm;
         result.converged = result.residual <= options.iteration.tolerance;
         while (!result.converged && result.iterations < options.iteration.max_iterations) {
             options.iteration.cancel.throw_if_requested("the viscosity solve");
+            refresh_ghosts(p);
             op.apply(p, q);
-            const double curvature = dot(p, q);
+            const double curvature = global_dot(p, q);
             if (!(curvature > 0.0)) {
                 break;
             }
@@ -740,10 +822,10 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
             axpy(alpha, p, x);
             axpy(-alpha, q, r);
             ++result.iterations;
-            result.residual = std::sqrt(dot(r, r)) / b_norm;
+            result.residual = std::sqrt(global_dot(r, r)) / b_norm;
             result.converged = result.residual <= options.iteration.tolerance;
             precondition();
-            const double rz_new = dot(r, z);
+            const double rz_new = global_dot(r, z);
             xpby(z, rz_new / rz, p);
             rz = rz_new;
         }
@@ -755,6 +837,10 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     for (int axis = 0; axis < 3; ++axis)  // the faces at n of periodic axes repeat those at 0
         if (walls.periodic(axis))
             copy_seam_faces(grid.velocity(axis), axis);
+    if (distributed)
+        for (int a = 0; a < 3; ++a)
+            exchange_halos(grid.velocity(a), ws.decomposition, ws.ranks,
+                           a == 2 ? LayerKind::z_faces : LayerKind::cells);
     return result;
 }
 

@@ -33,6 +33,7 @@
 #include <memory>
 
 #include "fluid/boundary.h"
+#include "fluid/halo_exchange.h"
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
 #include "fluid/multigrid.h"
@@ -104,6 +105,14 @@ public:
     ~ViscositySolver();
     ViscositySolver(ViscositySolver&&) noexcept;
     ViscositySolver& operator=(ViscositySolver&&) noexcept;
+
+    /// Makes every later solve() collective over `ranks`: the grid it is given is then this
+    /// rank's block of a grid split by `decomposition` (grid_block.h; at least 2 ghost layers,
+    /// current before the call, filled again after it) and the conjugate gradients run over the
+    /// whole grid, each rank owning its slab's faces (Jacobi preconditioner only, no surface
+    /// viscosity). One rank: solve() as without. Throws std::invalid_argument when the sizes do
+    /// not fit.
+    void distribute(const SlabDecomposition& decomposition, const RankCommunicator& ranks);
 
     /// See apply_viscosity().
     SolveResult solve(MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,

@@ -17,6 +17,7 @@
 #include "fluid/halo_exchange.h"
 #include "fluid/rank_communicator.h"
 #include "fluid/slab_decomposition.h"
+#include "fluid/viscosity.h"
 
 namespace meniscus::fluid {
 namespace {
@@ -242,6 +243,68 @@ TEST(DistributedProjection, BubbleBelowAnOutflow) {
 
 TEST(DistributedProjection, FreeSurfaceDrop) {
     expect_projection_matches({"free surface", FluidMode::free_surface, false, false, true});
+}
+
+/// The viscous solve of a bubble in a viscous liquid (viscous diffusion number 10 in the liquid,
+/// 1000 in the gas) on the whole grid against the ranks' blocks solved together.
+void expect_viscosity_matches(bool periodic_z, BoundaryType walls) {
+    const RankCommunicator world = ranks();
+    const int nx = 9, ny = 8, nz = 13;
+    BoundaryOptions boundaries = BoundaryOptions::all(walls);
+    if (periodic_z)
+        boundaries.z_min.type = boundaries.z_max.type = BoundaryType::periodic;
+    MacGrid whole(nx, ny, nz, DX);
+    whole.set_periodic({false, false, periodic_z});
+    stir(whole);
+    apply_boundary_velocity(whole, boundaries);
+    InterfaceInput interface(whole);
+    const Eigen::Vector3d centre(4.3 * DX, 3.6 * DX, 6.1 * DX);
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i)
+                interface.phi(i, j, k) = 2.7 * DX - (whole.cell_centre(i, j, k) - centre).norm();
+    PhaseOptions phases = water_and_air();
+    phases.mu_liquid = 10.0;  // νΔt/Δx² = 10 in the liquid
+    phases.mu_gas = 1e-3;     // 1000 in the gas
+    ViscosityOptions options;
+    options.iteration.tolerance = TOL;
+    options.iteration.max_iterations = 5000;
+
+    MacGrid reference = whole;
+    const SolveResult serial = apply_viscosity(reference, interface, phases, FluidMode::two_phase,
+                                               boundaries, DT, options);
+    ASSERT_TRUE(serial.converged);
+
+    const SlabDecomposition d(nz, world.size(), 3, periodic_z);
+    const int rank = world.rank();
+    MacGrid block = extract_block_grid(whole, d, rank);
+    const InterfaceInput block_interface = extract_block_interface(interface, d, rank);
+    ViscositySolver solver;
+    solver.distribute(d, world);
+    const SolveResult distributed =
+        solver.solve(block, block_interface, phases, FluidMode::two_phase,
+                     block_boundaries(boundaries, d, rank), DT, options);
+    EXPECT_TRUE(distributed.converged);
+    if (d.distributed()) {  // the same Krylov iteration, summed in another order
+        EXPECT_NEAR(distributed.iterations, serial.iterations, 2);
+    }
+    const MacGrid expected = extract_block_grid(reference, d, rank);
+    double scale = 0.0, difference = 0.0;
+    for (int axis = 0; axis < 3; ++axis)
+        for (std::size_t e = 0; e < expected.velocity(axis).size(); ++e) {
+            scale = std::max(scale, std::abs(expected.velocity(axis)[e]));
+            difference = std::max(difference,
+                                  std::abs(block.velocity(axis)[e] - expected.velocity(axis)[e]));
+        }
+    EXPECT_LE(difference, AGREEMENT * scale) << "rank " << rank;
+}
+
+TEST(DistributedViscosity, BubbleInAViscousLiquidBetweenNoSlipWalls) {
+    expect_viscosity_matches(false, BoundaryType::no_slip);
+}
+
+TEST(DistributedViscosity, BubbleAcrossAPeriodicSeam) {
+    expect_viscosity_matches(true, BoundaryType::free_slip);
 }
 
 }  // namespace
