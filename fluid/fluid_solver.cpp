@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
 
+#include "fluid/distributed_projection.h"
 #include "fluid/extrapolation.h"
 #include "fluid/forces.h"
 
@@ -26,16 +28,24 @@ const FluidOptions& validated(const FluidOptions& options) {
 constexpr double RESTING_CELLS_PER_STEP = 1e-12;
 
 /// Subtracts the mean over the pressure system's unknown cells (all cells in two_phase, liquid
-/// cells in free_surface) from `pressure` on those cells.
+/// cells in free_surface) from `pressure` on those cells (every cell of the block: the mean is a
+/// constant).
 void remove_unknown_mean(const InterfaceInput& interface, FluidMode mode,
-                         Array3<double>& pressure) {
+                         const BlockContext& blocks, Array3<double>& pressure) {
+    // On several ranks: the whole grid's mean, over the cells each rank owns.
+    const std::size_t layer =
+        static_cast<std::size_t>(pressure.ni()) * static_cast<std::size_t>(pressure.nj());
     double sum = 0.0;
     std::size_t count = 0;
-    for (std::size_t c = 0; c < pressure.size(); ++c)
+    for (std::size_t c = blocks.owned_cells_begin(layer); c < blocks.owned_cells_end(layer); ++c)
         if (mode == FluidMode::two_phase || is_liquid(interface.phi[c])) {
             sum += pressure[c];
             ++count;
         }
+    if (blocks.distributed()) {
+        sum = blocks.sum(sum);
+        count = static_cast<std::size_t>(blocks.sum(static_cast<double>(count)));
+    }
     if (count == 0)
         return;
     const double mean = sum / static_cast<double>(count);
@@ -71,10 +81,65 @@ void FluidOptions::validate() const {
 
 FluidSolver::FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3d& origin,
                          const FluidOptions& options)
-    : m_options(validated(options)), m_grid(nx, ny, nz, dx, origin), m_pressure(nx, ny, nz, 0.0) {
+    : FluidSolver(nx, ny, nz, dx, origin, options, SlabDecomposition(std::max(nz, 1)),
+                  RankCommunicator::self()) {}
+
+int FluidSolver::ghost_layers_needed(const FluidOptions& options) {
+    const int reach = static_cast<int>(std::ceil(options.time_step.cfl_number)) + 1;
+    const int traces = options.advection.scheme == AdvectionScheme::semi_lagrangian ? 1 : 2;
+    return std::max(traces * reach + 1, 2);
+}
+
+FluidSolver::FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3d& origin,
+                         const FluidOptions& options, const SlabDecomposition& decomposition,
+                         const RankCommunicator& ranks)
+    : m_options(validated(options)),
+      m_blocks(decomposition, ranks),
+      m_block_boundaries(block_boundaries(options.boundaries, decomposition, ranks.rank())),
+      m_grid(nx, ny, nz >= 1 ? decomposition.local_layers(ranks.rank()) : nz, dx,
+             origin + Eigen::Vector3d(0.0, 0.0, dx * decomposition.local_begin(ranks.rank()))),
+      m_pressure(nx, ny, m_grid.nz(), 0.0) {
     const BoundaryOptions& b = m_options.boundaries;
-    m_grid.set_periodic({b.periodic(0), b.periodic(1), b.periodic(2)});
-    apply_boundary_velocity(m_grid, m_options.boundaries);
+    if (decomposition.layers() != nz)
+        throw std::invalid_argument("FluidSolver: the decomposition splits " +
+                                    std::to_string(decomposition.layers()) +
+                                    " z-layers, the grid has " + std::to_string(nz));
+    if (decomposition.distributed()) {
+        if (decomposition.periodic() != b.periodic(2))
+            throw std::invalid_argument(
+                "FluidSolver: the decomposition and boundaries/z disagree on a periodic z");
+        if (decomposition.ghost_layers() < ghost_layers_needed(m_options))
+            throw std::invalid_argument(
+                "FluidSolver: " + std::to_string(decomposition.ghost_layers()) +
+                " ghost layers, the step needs " + std::to_string(ghost_layers_needed(m_options)));
+        for (int axis = 0; axis < 2; ++axis)
+            for (int side = 0; side < 2; ++side)
+                if (b.at(axis, side) == BoundaryType::inflow)
+                    throw std::invalid_argument(
+                        std::string("boundaries/") + (axis == 0 ? "x" : "y") +
+                        (side == 0 ? "_min" : "_max") +
+                        ": inflow faces on x or y are not available on several ranks (their "
+                        "profile spans z, which the ranks split); put the inflow on a z face");
+        if (m_options.viscosity.preconditioner != ViscousPreconditioner::jacobi)
+            throw std::invalid_argument(
+                "viscosity/preconditioner: only jacobi is available on several ranks");
+        m_viscosity.distribute(decomposition, ranks);
+    }
+    m_grid.set_periodic(
+        {b.periodic(0), b.periodic(1), b.periodic(2) && !decomposition.distributed()});
+    apply_boundary_velocity(m_grid, m_block_boundaries);
+    m_blocks.exchange(m_grid);
+}
+
+ProjectionResult FluidSolver::projection(MacGrid& grid, const InterfaceInput& interface,
+                                         const PhaseOptions& phases, double dt,
+                                         Array3<double>& pressure,
+                                         const BoundaryOptions& boundaries) const {
+    if (!m_blocks.distributed())
+        return project(grid, interface, phases, m_options.mode, dt, m_options.pressure, pressure,
+                       boundaries);
+    return project_block(grid, interface, phases, m_options.mode, dt, m_options.pressure, pressure,
+                         boundaries, m_blocks.decomposition(), m_blocks.ranks());
 }
 
 StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
@@ -87,12 +152,18 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
         throw std::invalid_argument(
             "FluidSolver::step: semi-implicit surface tension (a viscous solve) is not available "
             "with periodic faces yet");
+    if (m_blocks.distributed() && interface.surface_viscosity)
+        throw std::invalid_argument(
+            "FluidSolver::step: semi-implicit surface tension is not available on several ranks");
     StepResult result;
     PhaseClock step_clock;
     PhaseClock clock;
-    advect_velocity(m_grid, dt, m_options.advection, &m_options.boundaries);
+    // On several ranks each phase runs on the rank's block and its ghost layers are refreshed
+    // from their owners where the next phase reads them (grid_block.h).
+    advect_velocity(m_grid, dt, m_options.advection, &m_block_boundaries);
     m_time += dt;  // the step's velocities are those of its end
-    apply_boundary_velocity(m_grid, m_options.boundaries, m_time);
+    apply_boundary_velocity(m_grid, m_block_boundaries, m_time);
+    m_blocks.exchange(m_grid);
     clock.lap_into(result.timings.advection);
 
     if (m_options.viscous_pressure.coupling == ViscousPressureCoupling::split) {
@@ -104,6 +175,7 @@ StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
     if (m_options.mode == FluidMode::free_surface) {
         clock = PhaseClock();
         extrapolate_velocity(m_grid, interface, m_options.extrapolation_layers);
+        m_blocks.exchange(m_grid);
         clock.lap_into(result.timings.extrapolation);
     }
     m_was_liquid = liquid_cells(interface.phi);
@@ -116,20 +188,20 @@ void FluidSolver::split_step(double dt, const InterfaceInput& interface, StepRes
     // projection, so a fluid at rest in hydrostatic equilibrium stays exactly at rest.
     PhaseClock clock;
     result.viscosity =
-        m_viscosity.solve(m_grid, interface, m_options.phases, m_options.mode, m_options.boundaries,
+        m_viscosity.solve(m_grid, interface, m_options.phases, m_options.mode, m_block_boundaries,
                           dt, m_options.viscosity, m_options.pressure.min_liquid_fraction);
     clock.lap_into(result.timings.viscosity);
 
-    apply_gravity(m_grid, m_options.gravity, dt, m_options.boundaries);
+    apply_gravity(m_grid, m_options.gravity, dt, m_block_boundaries);
+    m_blocks.exchange(m_grid);
     clock.lap_into(result.timings.forces);
 
-    const ProjectionResult projection =
-        project(m_grid, interface, m_options.phases, m_options.mode, dt, m_options.pressure,
-                m_pressure, m_options.boundaries);
-    result.pressure = projection.solve;
-    result.max_divergence = projection.max_divergence;
-    result.timings.pressure_build += projection.build_time;
-    result.timings.pressure_solve += projection.solve_time;
+    const ProjectionResult projected =
+        projection(m_grid, interface, m_options.phases, dt, m_pressure, m_options.boundaries);
+    result.pressure = projected.solve;
+    result.max_divergence = projected.max_divergence;
+    result.timings.pressure_build += projected.build_time;
+    result.timings.pressure_solve += projected.solve_time;
 }
 
 void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, StepResult& result) {
@@ -137,9 +209,14 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
     const FluidMode mode = m_options.mode;
     const ViscousPressureOptions& scheme = m_options.viscous_pressure;
     const SurfaceViscosity* surface = interface.surface_viscosity.get();
-    const BoundaryOptions& boundaries = m_options.boundaries;
+    // The whole box's boundaries (for the projections) and this rank's block's (for the rest).
+    const BoundaryOptions& whole_boundaries = m_options.boundaries;
+    const BoundaryOptions& boundaries = m_block_boundaries;
     // The increments are homogeneous: walls at rest, inflows still, outflows at zero pressure.
     const BoundaryOptions increment_boundaries = boundaries.at_rest();
+    const BoundaryOptions whole_increment_boundaries = whole_boundaries.at_rest();
+    const std::size_t layer =
+        static_cast<std::size_t>(m_grid.nx()) * static_cast<std::size_t>(m_grid.ny());
     const bool implicit_tension = surface && surface->active();
     const bool viscous =
         (m_options.viscosity.enabled &&
@@ -167,11 +244,12 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
         MacGrid body(m_grid.nx(), m_grid.ny(), m_grid.nz(), m_grid.dx(), m_grid.origin());
         body.set_periodic(m_grid.periodic());
         apply_gravity(body, m_options.gravity, dt, boundaries);
-        add_solve(result.pressure, project(body, interface, phases, mode, dt, m_options.pressure,
-                                           m_pressure, boundaries)
-                                       .solve);
+        m_blocks.exchange(body);
+        add_solve(result.pressure,
+                  projection(body, interface, phases, dt, m_pressure, whole_boundaries).solve);
     }
     carry_pressure_to_new_phase(m_was_liquid, interface, phases, mode, m_pressure);
+    m_blocks.exchange(m_pressure);
     apply_gravity(m_grid, m_options.gravity, dt, boundaries);
     apply_pressure_gradient(m_grid, interface, phases, mode, dt, m_options.pressure, m_pressure,
                             boundaries);
@@ -180,6 +258,7 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
         // or the viscous solve would drag the liquid along with them (rest would not be exact).
         extrapolate_velocity(m_grid, interface, m_options.extrapolation_layers);
     }
+    m_blocks.exchange(m_grid);
     clock.lap_into(result.timings.forces);
     add_solve(result.viscosity,
               m_viscosity.solve(m_grid, interface, phases, mode, boundaries, dt,
@@ -215,10 +294,9 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
         }
         const double viscous_share = diffusion / (1.0 + diffusion);
         const auto divergence_ratio = [&]() {
-            double largest = 0.0;
-            for (double x : r)
-                largest = std::max(largest, std::abs(x));
-            const double speed = std::max(m_grid.max_abs_velocity().maxCoeff(), velocity_floor);
+            const double largest = m_blocks.max_abs_cells(r, layer);
+            const double speed =
+                std::max(m_blocks.max(m_grid.max_abs_velocity().maxCoeff()), velocity_floor);
             return viscous_share * largest * dx / speed;
         };
         result.pass_change = divergence_ratio();
@@ -233,14 +311,16 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
             clock.lap_into(result.timings.pressure_solve);
             system = build_pressure_system(m_grid, interface, increment_phases, mode, dt,
                                            m_options.pressure, increment_boundaries);
+            system.singular = m_blocks.all(system.singular);  // the whole system's
             clock.lap_into(result.timings.pressure_build);
-            poisson = std::make_unique<PressureSystemSolver>(system, m_options.pressure);
+            poisson = std::make_unique<PressureSystemSolver>(system, m_options.pressure, m_blocks);
             add_solve(result.pressure,
                       apply_cahouet_chabard(system, *poisson, scheme.preconditioner, interface,
-                                            phases, mode, dt, dx, r, z));
+                                            phases, mode, dt, dx, r, z, m_blocks));
             direction.resize(m_grid.nx(), m_grid.ny(), m_grid.nz(), 0.0);
             direction.storage() = z;
-            rz = dot(r, z);
+            m_blocks.exchange(direction);
+            rz = m_blocks.dot_cells(r, z, layer);
             impulse = MacGrid(m_grid.nx(), m_grid.ny(), m_grid.nz(), dx, m_grid.origin());
             impulse.set_periodic(m_grid.periodic());
         }
@@ -251,13 +331,14 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
                 impulse.velocity(axis).fill(0.0);
             apply_pressure_gradient(impulse, interface, increment_phases, mode, dt,
                                     m_options.pressure, direction, increment_boundaries);
+            m_blocks.exchange(impulse);
             add_solve(
                 result.viscosity,
                 m_viscosity.solve(impulse, interface, phases, mode, increment_boundaries, dt,
                                   m_options.viscosity, m_options.pressure.min_liquid_fraction));
             clock.lap_into(result.timings.viscosity);
             q = unknown_divergence(impulse, interface, mode);  // T s
-            const double curvature = dot(direction.storage(), q);
+            const double curvature = m_blocks.dot_cells(direction.storage(), q, layer);
             if (!(curvature > 0.0)) {
                 // Breakdown (inexact inner solves): the projection below still applies.
                 clock.lap_into(result.timings.pressure_solve);
@@ -280,12 +361,13 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
             if (!result.converged_passes) {
                 add_solve(result.pressure,
                           apply_cahouet_chabard(system, *poisson, scheme.preconditioner, interface,
-                                                phases, mode, dt, dx, r, z));
-                const double rz_new = dot(r, z);
+                                                phases, mode, dt, dx, r, z, m_blocks));
+                const double rz_new = m_blocks.dot_cells(r, z, layer);
                 const double beta = rz_new / rz;
                 rz = rz_new;
                 for (std::size_t c = 0; c < r.size(); ++c)
                     direction[c] = z[c] + beta * direction[c];
+                m_blocks.exchange(direction);
             }
             clock.lap_into(result.timings.pressure_solve);
         }
@@ -293,24 +375,32 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
 
     // The projection of what is left: u divergence-free to the pressure solver's tolerance.
     clock = PhaseClock();
-    const ProjectionResult projection =
-        project(m_grid, interface, increment_phases, mode, dt, m_options.pressure, m_increment,
-                increment_boundaries);
+    const ProjectionResult projected = projection(m_grid, interface, increment_phases, dt,
+                                                  m_increment, whole_increment_boundaries);
     for (std::size_t c = 0; c < m_pressure.size(); ++c)
         m_pressure[c] += m_increment[c];
-    if (projection.singular)
-        remove_unknown_mean(interface, mode, m_pressure);
-    add_solve(result.pressure, projection.solve);
-    result.max_divergence = projection.max_divergence;
+    if (projected.singular)
+        remove_unknown_mean(interface, mode, m_blocks, m_pressure);
+    add_solve(result.pressure, projected.solve);
+    result.max_divergence = projected.max_divergence;
     // The block's time less the assembly is solving.
     PhaseSeconds solving = clock.lap();
-    solving -= projection.build_time;
-    result.timings.pressure_build += projection.build_time;
+    solving -= projected.build_time;
+    result.timings.pressure_build += projected.build_time;
     result.timings.pressure_solve += solving;
 }
 
 TimeStepLimits FluidSolver::time_step_limits() const {
-    return compute_time_step(m_grid, m_options.phases, m_options.mode, m_options.time_step);
+    if (!m_blocks.distributed())
+        return compute_time_step(m_grid, m_options.phases, m_options.mode, m_options.time_step);
+    // The whole grid's limits come from its largest |u|, |v|, |w| (a block holds copies of its
+    // neighbours' faces, never other values): the same computation on a one-cell grid holding
+    // them (the other limits depend on Δx and the phases only).
+    const Eigen::Vector3d largest = m_grid.max_abs_velocity();
+    MacGrid probe(1, 1, 1, m_grid.dx());
+    for (int a = 0; a < 3; ++a)
+        probe.velocity(a).fill(m_blocks.max(largest[a]));
+    return compute_time_step(probe, m_options.phases, m_options.mode, m_options.time_step);
 }
 
 void FluidSolver::save_state(BinaryWriter& out) const {

@@ -14,8 +14,9 @@
 #include "common/phase_clock.h"
 
 #include "fluid/advection.h"
-#include "fluid/boundary.h"
 #include "fluid/array3.h"
+#include "fluid/boundary.h"
+#include "fluid/grid_block.h"
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
 #include "fluid/phases.h"
@@ -93,6 +94,22 @@ public:
     /// Throws std::invalid_argument for invalid sizes or options.
     FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3d& origin,
                 const FluidOptions& options);
+    /// Collective: rank `ranks.rank()`'s part of a solver on the same whole grid, split by
+    /// `decomposition` (its z-layers over ranks.size() ranks, with at least
+    /// ghost_layers_needed(options) ghost layers): grid(), pressure() and the interface given to
+    /// step() are this rank's block (grid_block.h), and every step is collective. The linear
+    /// solves run over the ranks (pressure through hypre whatever options.pressure.solver says;
+    /// viscosity by Jacobi-preconditioned CG). Not available on several ranks (throws
+    /// std::invalid_argument naming the field): inflow faces on x or y, the viscous multigrid
+    /// preconditioner, semi-implicit surface tension. One rank: as the constructor above.
+    FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3d& origin,
+                const FluidOptions& options, const SlabDecomposition& decomposition,
+                const RankCommunicator& ranks);
+
+    /// Ghost layers a distributed step needs: the advection's reach (a corrected scheme traces
+    /// back twice, each back-trace up to cfl_number cells plus its interpolation stencil) and
+    /// the viscous stencil's two layers.
+    static int ghost_layers_needed(const FluidOptions& options);
 
     /// Advances the velocity by `dt` seconds (> 0) with the interface `interface` (sized for the
     /// grid): advection, then viscosity, gravity and pressure coupled as
@@ -101,8 +118,11 @@ public:
     /// non-convergence is reported in the result, not thrown.
     StepResult step(double dt, const InterfaceInput& interface);
 
-    /// The time-step limits for the current velocity (CFL, viscous, capillary).
+    /// The time-step limits for the current velocity (CFL, viscous, capillary); collective on
+    /// several ranks (the whole grid's).
     TimeStepLimits time_step_limits() const;
+    /// How the grid is split over ranks (one process by default).
+    const BlockContext& blocks() const { return m_blocks; }
 
     MacGrid& grid() { return m_grid; }
     const MacGrid& grid() const { return m_grid; }
@@ -126,7 +146,15 @@ private:
     /// The incremental and coupled schemes.
     void incremental_step(double dt, const InterfaceInput& interface, StepResult& result);
 
+    /// project() or, on several ranks, project_block() with the whole box's `boundaries`.
+    ProjectionResult projection(MacGrid& grid, const InterfaceInput& interface,
+                                const PhaseOptions& phases, double dt, Array3<double>& pressure,
+                                const BoundaryOptions& boundaries) const;
+
     FluidOptions m_options;
+    BlockContext m_blocks;
+    /// The boundaries of this rank's block (m_options.boundaries on one process).
+    BoundaryOptions m_block_boundaries;
     MacGrid m_grid;
     Array3<double> m_pressure;
     Array3<double> m_increment;  ///< scratch: the projection's pressure increment δ

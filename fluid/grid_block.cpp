@@ -1,5 +1,9 @@
 #include "fluid/grid_block.h"
 
+#include "fluid/poisson_matrix.h"
+
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -22,6 +26,59 @@ void check_shape(const MacGrid& whole, const SlabDecomposition& d, const char* w
 }
 
 }  // namespace
+
+BlockContext::BlockContext(const SlabDecomposition& decomposition, const RankCommunicator& ranks)
+    : m_decomposition(decomposition), m_ranks(ranks) {
+    if (decomposition.ranks() != ranks.size())
+        throw std::invalid_argument("BlockContext: a decomposition over " +
+                                    std::to_string(decomposition.ranks()) + " ranks on " +
+                                    std::to_string(ranks.size()));
+}
+
+void BlockContext::exchange(Array3<double>& cells) const {
+    if (distributed())
+        exchange_halos(cells, m_decomposition, m_ranks, LayerKind::cells);
+}
+
+void BlockContext::exchange(MacGrid& block) const {
+    if (distributed())
+        exchange_velocity_halos(block, m_decomposition, m_ranks);
+}
+
+std::size_t BlockContext::owned_cells_begin(std::size_t layer) const {
+    if (!distributed())
+        return 0;
+    const int r = rank();
+    return layer * static_cast<std::size_t>(m_decomposition.owned_begin(r) -
+                                            m_decomposition.local_begin(r));
+}
+
+std::size_t BlockContext::owned_cells_end(std::size_t layer) const {
+    const int r = rank();
+    if (!distributed())
+        return layer * static_cast<std::size_t>(m_decomposition.layers());
+    return layer *
+           static_cast<std::size_t>(m_decomposition.owned_end(r) - m_decomposition.local_begin(r));
+}
+
+double BlockContext::dot_cells(const std::vector<double>& a, const std::vector<double>& b,
+                               std::size_t layer) const {
+    if (!distributed())
+        return dot(a, b);  // poisson_matrix.h's, as the one-process solvers use
+    double sum = 0.0;
+    for (std::size_t c = owned_cells_begin(layer); c < owned_cells_end(layer); ++c)
+        sum += a[c] * b[c];
+    return m_ranks.sum(sum);
+}
+
+double BlockContext::max_abs_cells(const std::vector<double>& a, std::size_t layer) const {
+    const std::size_t begin = distributed() ? owned_cells_begin(layer) : 0;
+    const std::size_t end = distributed() ? owned_cells_end(layer) : a.size();
+    double largest = 0.0;
+    for (std::size_t c = begin; c < end; ++c)
+        largest = std::max(largest, std::abs(a[c]));
+    return m_ranks.max(largest);
+}
 
 MacGrid block_grid(const MacGrid& whole, const SlabDecomposition& d, int rank) {
     check_shape(whole, d, "block_grid");

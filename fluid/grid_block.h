@@ -14,7 +14,46 @@
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
 
+#include <vector>
+
 namespace meniscus::fluid {
+
+/// A rank's place in a distributed run: how the grid is split, the ranks, and the collective
+/// operations the fluid step needs on its block. The default is one process, on which every
+/// operation is local (exchanges do nothing, sums are plain sums).
+class BlockContext {
+public:
+    BlockContext() = default;
+    /// Throws std::invalid_argument when the decomposition is not over ranks.size() ranks.
+    BlockContext(const SlabDecomposition& decomposition, const RankCommunicator& ranks);
+
+    bool distributed() const { return m_decomposition.distributed(); }
+    const SlabDecomposition& decomposition() const { return m_decomposition; }
+    const RankCommunicator& ranks() const { return m_ranks; }
+    int rank() const { return m_ranks.rank(); }
+
+    /// Collective: fills the ghost layers of a block's cell field, or of its three velocity
+    /// components.
+    void exchange(Array3<double>& cells) const;
+    void exchange(MacGrid& block) const;
+    /// Σ a_c b_c over the cells this rank owns, summed over the ranks; a and b are block cell
+    /// vectors with `layer` cells per z-layer (one process: over every cell).
+    double dot_cells(const std::vector<double>& a, const std::vector<double>& b,
+                     std::size_t layer) const;
+    /// max |a_c| over the cells this rank owns, over the ranks.
+    double max_abs_cells(const std::vector<double>& a, std::size_t layer) const;
+    /// The range [begin, end) of the flat indices of the owned cells of a block cell vector.
+    std::size_t owned_cells_begin(std::size_t layer) const;
+    std::size_t owned_cells_end(std::size_t layer) const;
+    double sum(double value) const { return m_ranks.sum(value); }
+    double max(double value) const { return m_ranks.max(value); }
+    double min(double value) const { return m_ranks.min(value); }
+    bool all(bool value) const { return m_ranks.all(value); }
+
+private:
+    SlabDecomposition m_decomposition;
+    RankCommunicator m_ranks = RankCommunicator::self();
+};
 
 /// The block of `rank` of a whole grid shaped like `whole` (its velocities are not copied), with
 /// zero velocity.

@@ -392,6 +392,14 @@ void HyprePressureSolver::apply(const std::vector<double>& r, std::vector<double
     s.get_vector(s.x, z);
 }
 
+void HyprePressureSolver::remove_mean(std::vector<double>& v) const {
+    if (v.size() != m_state->local_size())
+        throw std::invalid_argument("HyprePressureSolver::remove_mean: vector of " +
+                                    std::to_string(v.size()) + " values for " +
+                                    std::to_string(m_state->local_size()) + " cells");
+    m_state->remove_mean(v);
+}
+
 SolveResult solve_hypre_pfmg_pcg(const PoissonMatrix& matrix, const std::vector<double>& b,
                                  const IterativeSolverOptions& options, bool singular,
                                  std::vector<double>& x) {

@@ -71,6 +71,10 @@ public:
     SolveResult solve(const std::vector<double>& b, const IterativeSolverOptions& options,
                       std::vector<double>& x) const;
 
+    /// Subtracts from `v` (a block vector) its mean over the active owned cells of every rank
+    /// (collective; the projection onto the complement of a singular system's null space).
+    void remove_mean(std::vector<double>& v) const;
+
     /// z = one PFMG V-cycle applied to r (z resized; inactive entries zero). No mean projection:
     /// callers of a singular system project r and z (as PressureSystemSolver::precondition does).
     void apply(const std::vector<double>& r, std::vector<double>& z) const override;

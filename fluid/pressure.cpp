@@ -234,25 +234,40 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
 
 PressureSystemSolver::PressureSystemSolver(const PressureSystem& system,
                                            const PressureOptions& options)
+    : PressureSystemSolver(system, options, BlockContext()) {}
+
+PressureSystemSolver::PressureSystemSolver(const PressureSystem& system,
+                                           const PressureOptions& options,
+                                           const BlockContext& blocks)
     : m_system(system), m_options(options) {
     options.validate();
-    switch (options.solver) {
-        case PressureSolver::mic0_pcg:
-            m_preconditioner = std::make_unique<Mic0Preconditioner>(system.matrix, options.mic0);
-            break;
-        case PressureSolver::multigrid_pcg:
-            m_preconditioner =
-                std::make_unique<MultigridPreconditioner>(system.matrix, options.multigrid);
-            break;
-        case PressureSolver::eigen_ic_cg:
-            break;
-        case PressureSolver::hypre_pfmg_pcg: {
-            auto hypre = std::make_unique<HyprePressureSolver>(system.matrix, system.singular);
-            m_hypre = hypre.get();
-            m_preconditioner = std::move(hypre);
-            break;
+    if (!blocks.distributed()) {
+        switch (options.solver) {
+            case PressureSolver::mic0_pcg:
+                m_preconditioner =
+                    std::make_unique<Mic0Preconditioner>(system.matrix, options.mic0);
+                break;
+            case PressureSolver::multigrid_pcg:
+                m_preconditioner =
+                    std::make_unique<MultigridPreconditioner>(system.matrix, options.multigrid);
+                break;
+            case PressureSolver::eigen_ic_cg:
+                break;
+            case PressureSolver::hypre_pfmg_pcg: {
+                auto hypre = std::make_unique<HyprePressureSolver>(system.matrix, system.singular);
+                m_hypre = hypre.get();
+                m_preconditioner = std::move(hypre);
+                break;
+            }
         }
+        return;
     }
+    m_options.solver = PressureSolver::hypre_pfmg_pcg;
+    auto hypre = std::make_unique<HyprePressureSolver>(system.matrix, system.singular,
+                                                       blocks.decomposition(), blocks.ranks());
+    m_hypre = hypre.get();
+    m_preconditioner = std::move(hypre);
+    m_distributed = true;
 }
 
 PressureSystemSolver::~PressureSystemSolver() = default;
@@ -285,11 +300,18 @@ SolveResult PressureSystemSolver::precondition(const std::vector<double>& rhs,
                                     std::to_string(rhs.size()) + " values for " +
                                     std::to_string(a.size()) + " cells");
     std::vector<double> b = rhs, z;
+    // Distributed, the mean is the whole system's over every rank's owned cells.
+    const auto remove_mean = [&](std::vector<double>& v) {
+        if (m_distributed)
+            m_hypre->remove_mean(v);
+        else
+            remove_active_mean(a, v);
+    };
     if (m_system.singular)
-        remove_active_mean(a, b);
+        remove_mean(b);
     m_preconditioner->apply(b, z);
     if (m_system.singular)
-        remove_active_mean(a, z);
+        remove_mean(z);
     pressure.resize(a.ni(), a.nj(), a.nk(), 0.0);
     pressure.storage() = std::move(z);
     SolveResult result;

@@ -27,6 +27,7 @@
 #include "common/phase_clock.h"
 #include "fluid/array3.h"
 #include "fluid/boundary.h"
+#include "fluid/grid_block.h"
 #include "fluid/hypre_pressure.h"
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
@@ -90,6 +91,12 @@ class PressureSystemSolver {
 public:
     /// Throws std::invalid_argument naming the field when `options` are out of range.
     PressureSystemSolver(const PressureSystem& system, const PressureOptions& options);
+    /// Collective: `system` is this rank's block of the whole system (assembled on its block of
+    /// the grid; `singular` as the whole system's) and the solves run over every rank through
+    /// hypre (hypre_pfmg_pcg whatever options.solver says); results hold the owned cells, zero in
+    /// the ghost layers (BlockContext::exchange() fills them). One process: as above.
+    PressureSystemSolver(const PressureSystem& system, const PressureOptions& options,
+                         const BlockContext& blocks);
     ~PressureSystemSolver();
     PressureSystemSolver(const PressureSystemSolver&) = delete;
     PressureSystemSolver& operator=(const PressureSystemSolver&) = delete;
@@ -108,6 +115,7 @@ private:
     /// null for eigen_ic_cg; for hypre_pfmg_pcg the HyprePressureSolver (one PFMG V-cycle)
     std::unique_ptr<Preconditioner> m_preconditioner;
     const HyprePressureSolver* m_hypre = nullptr;  ///< m_preconditioner's, for hypre_pfmg_pcg
+    bool m_distributed = false;                    ///< over several ranks (hypre)
 };
 
 /// u ← u − Δt/ρ_f ∇p on every face adjacent to an unknown cell (ghost-fluid gradients with the σκ

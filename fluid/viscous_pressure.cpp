@@ -93,9 +93,9 @@ void carry_pressure_to_new_phase(const std::vector<char>& was_liquid,
 
 SolveResult apply_cahouet_chabard(const PressureSystem& system, const PressureSystemSolver& solver,
                                   SchurPreconditioner how, const InterfaceInput& interface,
-                                  const PhaseOptions& phases, FluidMode mode, double dt,
-                                  double dx, const std::vector<double>& r,
-                                  std::vector<double>& z) {
+                                  const PhaseOptions& phases, FluidMode mode, double dt, double dx,
+                                  const std::vector<double>& r, std::vector<double>& z,
+                                  const BlockContext& blocks) {
     const double scale = dx * dx / dt;
     std::vector<double> rhs(r.size(), 0.0);
     for (std::size_t c = 0; c < r.size(); ++c)
@@ -115,6 +115,21 @@ SolveResult apply_cahouet_chabard(const PressureSystem& system, const PressureSy
         z[c] = poisson[c] + 2.0 * mu * r[c];
         sum += z[c];
         ++count;
+    }
+    if (blocks.distributed()) {
+        // The whole system's mean: over the cells each rank owns.
+        const std::size_t layer = static_cast<std::size_t>(system.matrix.ni()) *
+                                  static_cast<std::size_t>(system.matrix.nj());
+        sum = 0.0;
+        count = 0;
+        for (std::size_t c = blocks.owned_cells_begin(layer); c < blocks.owned_cells_end(layer);
+             ++c)
+            if (system.matrix.diag[c] > 0.0) {
+                sum += z[c];
+                ++count;
+            }
+        sum = blocks.sum(sum);
+        count = static_cast<std::size_t>(blocks.sum(static_cast<double>(count)));
     }
     if (system.singular && count > 0) {
         const double mean = sum / static_cast<double>(count);

@@ -95,12 +95,13 @@ void carry_pressure_to_new_phase(const std::vector<char>& was_liquid,
 /// with A_p the pressure system's matrix (build_pressure_system()) for the same interface and
 /// time step, applied by `solver` (built on `system`) as `how` says; z has zero mean over the
 /// unknowns when the system is singular. Pa. Returns the Poisson solve's outcome (a V-cycle:
-/// converged, 1 iteration, residual 0).
+/// converged, 1 iteration, residual 0). Distributed (`blocks`; `solver` built with them): the
+/// mean is taken over every rank's owned cells, and z is valid on the owned cells only.
 SolveResult apply_cahouet_chabard(const PressureSystem& system, const PressureSystemSolver& solver,
                                   SchurPreconditioner how, const InterfaceInput& interface,
-                                  const PhaseOptions& phases, FluidMode mode, double dt,
-                                  double dx, const std::vector<double>& r,
-                                  std::vector<double>& z);
+                                  const PhaseOptions& phases, FluidMode mode, double dt, double dx,
+                                  const std::vector<double>& r, std::vector<double>& z,
+                                  const BlockContext& blocks = {});
 
 /// The divergence (1/s) of every unknown cell of the pressure system (all cells in two_phase,
 /// liquid cells in free_surface), 0 elsewhere, in the Array3 layout of the cells.
