@@ -28,6 +28,9 @@ namespace {
 
 using namespace meniscus::app;
 
+/// Set once a run has started on several MPI ranks.
+bool g_distributed_run = false;
+
 constexpr int EXIT_OK = 0;
 constexpr int EXIT_INTERNAL = 1;
 constexpr int EXIT_BAD_INPUT = 2;
@@ -181,6 +184,16 @@ int command_run(const std::vector<std::string>& args) {
     if (scene_path.empty() && !options.resume)
         throw UsageError("run: no scene file given");
     const auto thread_limit = thread_control(threads);
+    // Under mpirun (or another MPI launcher) with more than one rank, a fluid scene's grid is
+    // split over the ranks (issue 40); without a launcher MPI is not even started here.
+    if (meniscus::fluid::launched_by_mpi_launcher()) {
+        options.ranks = meniscus::fluid::RankCommunicator::world();
+        if (options.ranks.size() > 1) {
+            g_distributed_run = true;
+            if (options.ranks.rank() != 0)
+                options.quiet = true;
+        }
+    }
     install_stop_signal_handlers();
     std::string note;
     const Scene scene = options.resume
@@ -188,6 +201,9 @@ int command_run(const std::vector<std::string>& args) {
                             : load_scene(scene_path);
     if (!note.empty())
         std::fprintf(stderr, "meniscus: warning: %s\n", note.c_str());
+    if (options.ranks.size() > 1 && scene.flow.type != "fluid")
+        throw UsageError("run: a geometric flow (/flow/type " + scene.flow.type +
+                         ") has no grid to split: run it without mpirun");
     const RunResult result = run_scene(scene, options, stop_requested_flag());
     if (result.interrupted) {
         std::fprintf(stderr, "meniscus: interrupted at t = %g s; frames 0..%d in %s are complete\n",
@@ -256,7 +272,7 @@ int dispatch(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run_main(int argc, char** argv) {
     try {
         return dispatch(argc, argv);
     } catch (const UsageError& e) {
@@ -296,4 +312,13 @@ int main(int argc, char** argv) {
                      e.what());
         return EXIT_INTERNAL;
     }
+}
+
+int main(int argc, char** argv) {
+    const int code = run_main(argc, argv);
+    // A rank of a distributed run that fails ends the job: the others would wait for it in their
+    // next collective call for ever.
+    if (g_distributed_run && code != EXIT_OK && code != stop_exit_code())
+        meniscus::fluid::RankCommunicator::world().abort(code);
+    return code;
 }

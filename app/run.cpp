@@ -302,6 +302,7 @@ nlohmann::json fluid_frame_stats(int frame, double time, long long steps,
                 for (int i = 0; i < u.ni(); ++i)
                     max_speed = std::max(max_speed, std::abs(u(i, j, k)));
     }
+    max_speed = sim.fluid().blocks().max(max_speed);  // the whole grid's on several ranks
     nlohmann::json line = {{"frame", frame},
                            {"time", time},
                            {"dt", last.dt},
@@ -443,6 +444,16 @@ SurfaceMesh placeholder_surface(const tracker::MeshPeriods& periods = {}) {
 /// exception still knows what was written).
 static void run_fluid_scene(const Scene& scene, const RunOptions& options,
                             const std::atomic<bool>& stop, RunResult& result) {
+    // On several MPI ranks (issue 40) every rank steps its part of the simulation and rank 0
+    // alone writes: the frames (the VDB's grids gathered from every rank), the stats and the
+    // progress. Every call below that reads the grid is collective.
+    const fluid::RankCommunicator& ranks = options.ranks;
+    const bool distributed = ranks.size() > 1;
+    const bool root = ranks.rank() == 0;
+    if (distributed && options.resume)
+        throw InputError(
+            "--resume is not available on several MPI ranks yet (checkpoints hold "
+            "one process's state); resume without mpirun");
     const std::optional<Resume> resume = read_resume(scene, options);
     std::string report;
     double nominal_xi = 0.0;
@@ -456,16 +467,25 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
         report = "resumed at frame " + std::to_string(resume->checkpoint.header.frame) +
                  " from " + options.out_dir + "/" + CHECKPOINT_NAME;
     } else {
-        prepare_output_dir(options.out_dir);
+        if (root)
+            prepare_output_dir(options.out_dir);
         SurfaceMesh initial = checked_initial_surface(scene, options.limits, &report, &nominal_xi);
-        simulation.emplace(make_fluid_simulation(scene, std::move(initial), nominal_xi));
+        simulation.emplace(make_fluid_simulation(scene, std::move(initial), nominal_xi, ranks));
     }
     coupling::Simulation& sim = *simulation;
     const double dx = sim.fluid().grid().dx();
+    const std::array<int, 3> cells = sim.fluid().box_cells();
     if (!options.quiet)
-        std::fprintf(stderr, "%s: %s; fluid grid %d x %d x %d, dx = %g m\n", scene.name.c_str(),
-                     report.c_str(), sim.fluid().grid().nx(), sim.fluid().grid().ny(),
-                     sim.fluid().grid().nz(), dx);
+        std::fprintf(stderr, "%s: %s; fluid grid %d x %d x %d, dx = %g m%s\n", scene.name.c_str(),
+                     report.c_str(), cells[0], cells[1], cells[2], dx,
+                     distributed ? (", split over " + std::to_string(ranks.size()) +
+                                    " MPI ranks in slabs of z-layers")
+                                       .c_str()
+                                 : "");
+    if (distributed && scene.output.checkpoint_every > 0 && !options.quiet)
+        std::fprintf(stderr,
+                     "meniscus: warning: no checkpoints on several MPI ranks yet "
+                     "(/output/checkpoint_every is ignored)\n");
 
     const int frames =
         resume ? resume->frames : options.frames > 0 ? options.frames : scene.time.frames;
@@ -475,14 +495,43 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
     if (resume)
         frame_writer.emplace(scene, options.out_dir, options.quiet, frames,
                              resume->checkpoint.header, resume->bytes);
-    else
+    else if (root)
         frame_writer.emplace(scene, options.out_dir, options.quiet, frames);
-    FrameWriter& writer = *frame_writer;
-    Checkpointer checkpointer(scene, options, frames, nominal_xi);
+    Scene checkpointed = scene;
+    if (distributed)
+        checkpointed.output.checkpoint_every = 0;
+    Checkpointer checkpointer(checkpointed, options, frames, nominal_xi);
     const auto save = [&](BinaryWriter& out) { sim.save_state(out); };
     Progress progress(stderr, options.quiet);
+    // The whole grid's velocities and pressure on rank 0 (gathered from every rank's slab) when
+    // the VDB files need them.
+    std::optional<fluid::MacGrid> whole_grid;
+    fluid::Array3<double> whole_pressure;
     const auto fields = [&]() {
-        return coupling::FluidFields{&sim.fluid().grid(), &sim.fluid().pressure()};
+        if (!distributed)
+            return coupling::FluidFields{&sim.fluid().grid(), &sim.fluid().pressure()};
+        if (!scene.output.vdb)
+            return coupling::FluidFields{};
+        const fluid::SlabDecomposition& d = sim.fluid().blocks().decomposition();
+        if (!whole_grid) {
+            whole_grid.emplace(root ? cells[0] : 1, root ? cells[1] : 1, root ? cells[2] : 1, dx,
+                               sim.fluid().box_min());
+            whole_grid->set_periodic(
+                {sim.fluid().grid().periodic()[0], sim.fluid().grid().periodic()[1], d.periodic()});
+        }
+        fluid::gather_velocities(sim.fluid().grid(), d, ranks, *whole_grid, 0);
+        whole_pressure =
+            fluid::gather_field(sim.fluid().pressure(), d, ranks, fluid::LayerKind::cells, 0);
+        return coupling::FluidFields{&*whole_grid, &whole_pressure};
+    };
+    // A stop (Ctrl-C, SIGTERM: mpirun passes them to every rank) counts once any rank has seen
+    // it, so that every rank leaves at the same step.
+    std::atomic<bool> agreed_stop{false};
+    const auto stop_flag = [&]() -> const std::atomic<bool>& {
+        if (!distributed)
+            return stop;
+        agreed_stop.store(ranks.max(stop.load() ? 1.0 : 0.0) > 0.0);
+        return agreed_stop;
     };
 
     coupling::SimulationStepReport last;
@@ -499,12 +548,16 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
     } else {
         FluidFrameTimes times;
         PhaseClock output_clock;
-        writer.write(0, sim.tracker().mesh(), sim.vertex_velocities(), fields());
+        const coupling::FluidFields grids = fields();
+        if (root)
+            frame_writer->write(0, sim.tracker().mesh(), sim.vertex_velocities(), grids);
         output_clock.lap_into(times.output);
         nlohmann::json line =
             fluid_frame_stats(0, 0.0, 0, sim, last, times.json(), nlohmann::json::object());
-        checkpointer.write(0, 0.0, result, 0.0, 0, line, writer, save);
-        writer.stats(line);
+        if (root) {
+            checkpointer.write(0, 0.0, result, 0.0, 0, line, *frame_writer, save);
+            frame_writer->stats(line);
+        }
         result.frames_written = 1;
     }
     for (int frame = first_frame; frame <= frames; ++frame) {
@@ -515,7 +568,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
         FrameSolves solves;
         FrameOpenBoundaries open_faces;
         while (t < t_frame) {
-            if (should_stop(options, stop, t, progress, result))
+            if (should_stop(options, stop_flag(), t, progress, result))
                 return;
             last = sim.step(t_frame - t, scene.time.dt);
             solves.add(last.fluid);
@@ -532,7 +585,9 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
             ++result.steps;
         }
         PhaseClock output_clock;
-        writer.write(frame, sim.tracker().mesh(), sim.vertex_velocities(), fields());
+        const coupling::FluidFields grids = fields();
+        if (root)
+            frame_writer->write(frame, sim.tracker().mesh(), sim.vertex_velocities(), grids);
         output_clock.lap_into(times.output);
         nlohmann::json work = {{"intersecting_pairs", intersecting},
                                {"merges", merges},
@@ -550,8 +605,10 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
             progress.finish();
             std::fprintf(stderr, "%s\n", deferred.c_str());
         }
-        checkpointer.write(frame, t, result, 0.0, 0, line, writer, save);
-        writer.stats(line);
+        if (root) {
+            checkpointer.write(frame, t, result, 0.0, 0, line, *frame_writer, save);
+            frame_writer->stats(line);
+        }
         const std::string warning = solves.warning(frame, steps);
         if (!warning.empty() && !options.quiet) {
             progress.finish();

@@ -5,6 +5,7 @@
 #include "app/errors.h"
 #include "app/resource_estimate.h"
 #include "app/scene.h"
+#include "fluid/rank_communicator.h"
 #include "tracker/mesh.h"
 
 #include <atomic>
@@ -23,6 +24,9 @@ struct RunOptions {
     /// Continue the run in out_dir from its checkpoint (app/checkpoint.h) instead of starting:
     /// the scene must be the one the checkpoint holds (scene_for_resume()).
     bool resume = false;
+    /// The ranks of a run under mpirun (issue 40): a fluid scene's grid is split over them, rank 0
+    /// writes the frames and the stats; this process alone by default.
+    fluid::RankCommunicator ranks = fluid::RankCommunicator::self();
 };
 
 /// The scene of `meniscus run --resume DIR [SCENE]`: SCENE, or the scene file the checkpoint in

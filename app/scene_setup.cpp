@@ -291,17 +291,37 @@ SurfaceMesh checked_initial_surface(const Scene& scene, const ResourceLimits& li
 }
 
 coupling::Simulation make_fluid_simulation(const Scene& scene, SurfaceMesh initial,
-                                           double nominal_xi) {
+                                           double nominal_xi,
+                                           const fluid::RankCommunicator& ranks) {
     check_periodic_faces(scene);
     const double dx = scene.domain.size.x() / scene.domain.cells;
     fluid::FluidOptions options = scene.fluid;
-    options.pressure.iteration.cancel = scene.cancel;
-    options.viscosity.iteration.cancel = scene.cancel;
-    fluid::FluidSolver solver(scene.domain.cells, fluid_cells_along(scene, 1),
-                              fluid_cells_along(scene, 2), dx, scene.domain.min, options);
+    const int nz = fluid_cells_along(scene, 2);
+    const bool distributed = ranks.size() > 1;
+    if (!distributed) {
+        options.pressure.iteration.cancel = scene.cancel;
+        options.viscosity.iteration.cancel = scene.cancel;
+    }
+    // On several ranks a solve is never cancelled half-way (every rank must leave it together):
+    // the run stops between steps instead (app/run.cpp).
+    fluid::SlabDecomposition decomposition(nz);
+    if (distributed) {
+        try {
+            decomposition = fluid::SlabDecomposition(
+                nz, ranks.size(), fluid::FluidSolver::ghost_layers_needed(options),
+                options.boundaries.periodic(2));
+        } catch (const std::invalid_argument& e) {
+            throw InputError(std::string("/domain: the grid's ") + std::to_string(nz) +
+                             " cells along z cannot be split over " + std::to_string(ranks.size()) +
+                             " MPI ranks (" + e.what() + ")");
+        }
+    }
+    fluid::FluidSolver solver(scene.domain.cells, fluid_cells_along(scene, 1), nz, dx,
+                              scene.domain.min, options, decomposition, ranks);
     apply_initial_velocity(scene.initial_velocity, solver.grid(), scene.cancel);
     // The velocity regions may have reached the box's faces.
-    fluid::apply_boundary_velocity(solver.grid(), options.boundaries, solver.time());
+    fluid::apply_boundary_velocity(solver.grid(), solver.grid_boundaries(), solver.time());
+    solver.refresh_ghost_layers();
     check_inflow_phases(scene, initial, solver.grid());
     return coupling::Simulation(
         tracker::SurfaceTracker(std::move(initial), tracker_options(scene, nominal_xi)),

@@ -36,9 +36,12 @@ tracker::TrackerOptions tracker_options(const Scene& scene, double nominal_xi);
 tracker::SurfaceMesh checked_initial_surface(const Scene& scene, const ResourceLimits& limits,
                                              std::string* report, double* nominal_xi);
 
-/// The coupled simulation of a fluid scene from its initial surface (see below).
-coupling::Simulation make_fluid_simulation(const Scene& scene, tracker::SurfaceMesh initial,
-                                           double nominal_xi);
+/// The coupled simulation of a fluid scene from its initial surface (see below). On several
+/// `ranks` (a run under mpirun) this rank's part of it: the grid split into slabs of z-layers
+/// (fluid/slab_decomposition.h) with the ghost layers the fluid step needs, the mesh replicated.
+coupling::Simulation make_fluid_simulation(
+    const Scene& scene, tracker::SurfaceMesh initial, double nominal_xi,
+    const fluid::RankCommunicator& ranks = fluid::RankCommunicator::self());
 
 /// The coupled simulation of a fluid scene as `meniscus run` sets it up: the grid from /domain
 /// (cubic cells, /domain/cells along x), the initial surface from /surface (build_initial_surface(),

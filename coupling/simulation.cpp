@@ -25,9 +25,21 @@ const char* const AXIS_NAMES[3] = {"x", "y", "z"};
 void check_periods(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
                    const fluid::BoundaryOptions& boundaries) {
     const tracker::MeshPeriods& periods = mesh.periods();
+    for (int a = 0; a < 3; ++a)
+        if (grid.periodic()[static_cast<size_t>(a)] != boundaries.periodic(a) && periods.any())
+            throw std::invalid_argument(std::string("periods: the grid and the boundaries "
+                                                    "disagree on a periodic ") +
+                                        AXIS_NAMES[a]);
+    check_periods(mesh, grid.origin(), {grid.nx(), grid.ny(), grid.nz()}, grid.dx(), boundaries);
+}
+
+void check_periods(const tracker::SurfaceMesh& mesh, const Eigen::Vector3d& box_min,
+                   const std::array<int, 3>& cells, double dx,
+                   const fluid::BoundaryOptions& boundaries) {
+    const tracker::MeshPeriods& periods = mesh.periods();
     for (int a = 0; a < 3; ++a) {
         const std::string axis = AXIS_NAMES[a];
-        const bool box = grid.periodic()[static_cast<size_t>(a)];
+        const bool box = boundaries.periodic(a);
         if (box != periods.wraps(a))
             throw std::invalid_argument(
                 box ? "periods: the fluid box is periodic along " + axis +
@@ -36,9 +48,9 @@ void check_periods(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
                           " but the fluid box is not periodic along it");
         if (!box)
             continue;
-        const double length = grid.dx() * grid.cells(a);
+        const double length = dx * cells[static_cast<size_t>(a)];
         if (std::abs(periods.length[a] - length) > 1e-9 * length ||
-            std::abs(periods.origin[a] - grid.origin()[a]) > 1e-9 * length)
+            std::abs(periods.origin[a] - box_min[a]) > 1e-9 * length)
             throw std::invalid_argument("periods: the surface mesh's period along " + axis +
                                         " is not the fluid box's (origin and length must match)");
     }
@@ -91,7 +103,19 @@ Simulation::Simulation(tracker::SurfaceTracker tracker, fluid::FluidSolver fluid
       m_fluid(std::move(fluid)),
       m_options(options) {
     m_options.validate();
-    check_periods(m_tracker->mesh(), m_fluid.grid(), m_fluid.options().boundaries);
+    check_periods(m_tracker->mesh(), m_fluid.box_min(), m_fluid.box_cells(), m_fluid.grid().dx(),
+                  m_fluid.options().boundaries);
+    if (m_fluid.blocks().distributed()) {
+        const fluid::BoundaryOptions& b = m_fluid.options().boundaries;
+        if (b.open() || b.inflow())
+            throw std::invalid_argument(
+                "boundaries: inflow and outflow faces are not available on several MPI ranks yet "
+                "(the mesh's clipping and the nozzle need the whole box)");
+        if (m_options.implicit_tension > 0.0)
+            throw std::invalid_argument(
+                "implicit_tension: not available on several MPI ranks yet; use explicit surface "
+                "tension (0)");
+    }
     if (m_tracker->mesh().periodic() && m_options.implicit_tension > 0.0)
         throw std::invalid_argument(
             "implicit_tension: not available with periodic faces (the surface viscosity does "
@@ -184,8 +208,10 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     }
 
     // (4) Grid → mesh.
-    m_vertex_velocities =
-        interpolate_vertex_velocities(m_fluid.grid(), mesh, m_options.interpolate, boundaries);
+    m_vertex_velocities = interpolate_vertex_velocities(m_fluid.grid(), mesh, m_options.interpolate,
+                                                        m_fluid.grid_boundaries());
+    if (m_fluid.blocks().distributed())
+        combine_rank_velocities(m_vertex_velocities);
     if (boundaries.inflow())
         held = held_vertices(mesh, grid, boundaries);  // renumbered since
     for (size_t v = 0; v < held.size(); ++v)
@@ -206,12 +232,58 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     }
     report.integrate = m_tracker->integrate(velocities, report.dt, pinned);
     clock.lap_into(timings.tracker);
+    if (m_fluid.blocks().distributed())
+        check_replicated_mesh();
     for (const PhaseSeconds* phase :
          {&timings.rasterize, &timings.curvature, &timings.fluid, &timings.interpolate,
           &timings.volume_correction, &timings.tracker})
         timings.total += *phase;
     m_time += report.integrate.time_advanced;
     return report;
+}
+
+void Simulation::combine_rank_velocities(std::vector<tracker::Vec3>& velocities) const {
+    // Each vertex belongs to the rank owning the cell layer its z lies in (wrapped around a
+    // periodic z, clamped to the end layers beyond the box's z walls); the others' values are
+    // dropped and the owners' summed over the ranks. The owner's block covers the vertex's
+    // interpolation stencil (FluidSolver::ghost_layers_needed() ≥ 2).
+    const fluid::BlockContext& blocks = m_fluid.blocks();
+    const fluid::SlabDecomposition& d = blocks.decomposition();
+    const tracker::SurfaceMesh& mesh = m_tracker->mesh();
+    const double z0 = m_fluid.box_min().z(), dx = m_fluid.grid().dx();
+    std::vector<double> flat(3 * velocities.size(), 0.0);
+    for (size_t v = 0; v < velocities.size(); ++v) {
+        if (!mesh.vertex_alive(static_cast<int>(v)))
+            continue;
+        int layer =
+            static_cast<int>(std::floor((mesh.position(static_cast<int>(v)).z() - z0) / dx));
+        if (!d.periodic())
+            layer = std::clamp(layer, 0, d.layers() - 1);
+        if (d.owner(layer) != blocks.rank())
+            continue;
+        for (int a = 0; a < 3; ++a)
+            flat[3 * v + static_cast<size_t>(a)] = velocities[v][a];
+    }
+    blocks.ranks().sum_in_place(flat);
+    for (size_t v = 0; v < velocities.size(); ++v)
+        velocities[v] = tracker::Vec3(flat[3 * v], flat[3 * v + 1], flat[3 * v + 2]);
+}
+
+void Simulation::check_replicated_mesh() const {
+    // A checksum of the live vertex positions and the mesh's size: equal on every rank while the
+    // replicated tracker stays deterministic.
+    const tracker::SurfaceMesh& mesh = m_tracker->mesh();
+    double sum = static_cast<double>(mesh.num_vertices()) + 1e3 * mesh.num_triangles();
+    for (int v = 0; v < mesh.num_vertices(); ++v)
+        if (mesh.vertex_alive(v)) {
+            const tracker::Vec3& x = mesh.position(v);
+            sum += (1.0 + 1e-3 * (v % 97)) * (x.x() + 2.0 * x.y() + 3.0 * x.z());
+        }
+    const fluid::BlockContext& blocks = m_fluid.blocks();
+    if (blocks.max(sum) != blocks.min(sum))
+        throw std::runtime_error(
+            "Simulation: the ranks' copies of the surface mesh differ after a step (the "
+            "replicated tracker was not deterministic)");
 }
 
 double Simulation::unroll_margin(double mean_edge) const {
@@ -237,9 +309,8 @@ void Simulation::add_subgrid_tension(std::vector<tracker::Vec3>& velocities, dou
     const double t_h = std::sqrt(rho_mean * h * h * h / (2.0 * M_PI * phases.sigma));
     const double diffusivity = options.subgrid_rate * h * h / t_h;
     // Only vertices inside the fluid box (see subgrid_tension_velocities()).
-    const fluid::MacGrid& grid = m_fluid.grid();
-    const tracker::Vec3 lo = grid.origin();
-    const tracker::Vec3 hi = lo + grid.dx() * tracker::Vec3(grid.nx(), grid.ny(), grid.nz());
+    const tracker::Vec3 lo = m_fluid.box_min();
+    const tracker::Vec3 hi = m_fluid.box_max();
     std::vector<char> inside(static_cast<size_t>(mesh.num_vertices()), 0);
     for (int vi = 0; vi < mesh.num_vertices(); ++vi) {
         if (!mesh.vertex_alive(vi))
@@ -269,10 +340,19 @@ double Simulation::kinetic_energy() const {
                                  std::clamp(k, 0, grid.nz() - 1));
         return phi < 0.0 ? phases.rho_liquid : (two_phase ? phases.rho_gas : 0.0);
     };
+    // On several ranks each sums the faces of its own layers (the last rank also the top
+    // z-faces of a walled box).
+    const fluid::BlockContext& blocks = m_fluid.blocks();
+    const fluid::SlabDecomposition& d = blocks.decomposition();
+    const int rank = blocks.rank();
+    const int k_begin = blocks.distributed() ? d.owned_begin(rank) - d.local_begin(rank) : 0;
     double energy = 0.0;
     for (int axis = 0; axis < 3; ++axis) {
         const fluid::Array3<double>& u = grid.velocity(axis);
-        for (int k = 0; k < u.nk(); ++k)
+        const bool top = axis == 2 && !d.periodic() && rank == d.ranks() - 1;
+        const int k_end =
+            blocks.distributed() ? d.owned_end(rank) - d.local_begin(rank) + (top ? 1 : 0) : u.nk();
+        for (int k = k_begin; k < k_end; ++k)
             for (int j = 0; j < u.nj(); ++j)
                 for (int i = 0; i < u.ni(); ++i) {
                     // Face between cells (i−1) and i along `axis`: average their densities.
@@ -282,7 +362,7 @@ double Simulation::kinetic_energy() const {
                     energy += 0.5 * rho * u(i, j, k) * u(i, j, k) * cell_volume;
                 }
     }
-    return energy;
+    return blocks.distributed() ? blocks.sum(energy) : energy;
 }
 
 void Simulation::save_state(BinaryWriter& out) const {

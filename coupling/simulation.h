@@ -18,6 +18,7 @@
 #include "fluid/fluid_solver.h"
 #include "tracker/surface_tracker.h"
 
+#include <array>
 #include <limits>
 #include <memory>
 #include <string>
@@ -101,10 +102,23 @@ struct SimulationStepReport {
 /// the axis and the conflict.
 void check_periods(const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid,
                    const fluid::BoundaryOptions& boundaries);
+/// The same for a box of `cells` cells of edge `dx` from `box_min`, periodic along the axes
+/// whose faces in `boundaries` are (a distributed solver's whole box, FluidSolver::box_min()).
+void check_periods(const tracker::SurfaceMesh& mesh, const Eigen::Vector3d& box_min,
+                   const std::array<int, 3>& cells, double dx,
+                   const fluid::BoundaryOptions& boundaries);
 
 /// Owns the tracker and the fluid solver and steps them together. A periodic mesh is rasterized
 /// and its curvature taken on its images around the box (periodic_images.h); vertex velocities
 /// are sampled on the periodic grid.
+///
+/// With a FluidSolver split over MPI ranks (issue 40) every rank holds a Simulation and steps it
+/// together with the others: the tracker is replicated (every rank moves the same mesh with the
+/// same velocities, and a checksum of the vertex positions is compared across the ranks after
+/// every step: a difference throws std::runtime_error), each rank rasterizes φ and κ on its own
+/// block, and each vertex's velocity is interpolated by the rank owning the cell layer it lies
+/// in and summed over the ranks. Not available there (throws std::invalid_argument naming the
+/// field): inflow and outflow faces, implicit_tension.
 class Simulation {
 public:
     /// Throws std::invalid_argument on bad options or periods that do not match (check_periods).
@@ -124,7 +138,8 @@ public:
     /// Per-vertex velocities of the last step interpolated from the grid (sized
     /// mesh().num_vertices()), m/s; without the sub-grid and volume-correction terms.
     const std::vector<tracker::Vec3>& vertex_velocities() const { return m_vertex_velocities; }
-    /// Kinetic energy ½ Σ ρ u² dV over the grid's faces (J), liquid and gas by φ.
+    /// Kinetic energy ½ Σ ρ u² dV over the grid's faces (J), liquid and gas by φ (collective on
+    /// several ranks: the whole grid's).
     double kinetic_energy() const;
     /// Volumes that entered through inflow faces and were clipped off at outflow faces since the
     /// start of the run (m³; kept in the state).
@@ -143,6 +158,10 @@ private:
     void add_subgrid_tension(std::vector<tracker::Vec3>& velocities, double dt) const;
     /// How far beyond the box a periodic mesh is unrolled for the grid-side code (m).
     double unroll_margin(double mean_edge) const;
+    /// Several ranks: keeps each vertex's velocity from the rank that owns it, on every rank.
+    void combine_rank_velocities(std::vector<tracker::Vec3>& velocities) const;
+    /// Several ranks: throws std::runtime_error unless every rank holds the same mesh.
+    void check_replicated_mesh() const;
 
     std::unique_ptr<tracker::SurfaceTracker> m_tracker;  // stable address for the observer
     fluid::FluidSolver m_fluid;

@@ -96,6 +96,8 @@ FluidSolver::FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3
     : m_options(validated(options)),
       m_blocks(decomposition, ranks),
       m_block_boundaries(block_boundaries(options.boundaries, decomposition, ranks.rank())),
+      m_box_min(origin),
+      m_box_cells{nx, ny, nz},
       m_grid(nx, ny, nz >= 1 ? decomposition.local_layers(ranks.rank()) : nz, dx,
              origin + Eigen::Vector3d(0.0, 0.0, dx * decomposition.local_begin(ranks.rank()))),
       m_pressure(nx, ny, m_grid.nz(), 0.0) {

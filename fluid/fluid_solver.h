@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <utility>
 
 #include "common/phase_clock.h"
@@ -123,6 +124,21 @@ public:
     TimeStepLimits time_step_limits() const;
     /// How the grid is split over ranks (one process by default).
     const BlockContext& blocks() const { return m_blocks; }
+    /// The whole box: min corner (m), cells per axis, max corner (m); grid() is its block of it
+    /// on several ranks, the box itself on one.
+    const Eigen::Vector3d& box_min() const { return m_box_min; }
+    const std::array<int, 3>& box_cells() const { return m_box_cells; }
+    Eigen::Vector3d box_max() const {
+        return m_box_min +
+               m_grid.dx() * Eigen::Vector3d(m_box_cells[0], m_box_cells[1], m_box_cells[2]);
+    }
+    /// The boundaries of grid(): options().boundaries, with a block's inner ends as free-slip
+    /// walls on several ranks (block_boundaries()).
+    const BoundaryOptions& grid_boundaries() const { return m_block_boundaries; }
+
+    /// Collective on several ranks: fills the ghost layers of grid() from their owners, after its
+    /// velocities were set from outside (an initial field, a checkpoint).
+    void refresh_ghost_layers() { m_blocks.exchange(m_grid); }
 
     MacGrid& grid() { return m_grid; }
     const MacGrid& grid() const { return m_grid; }
@@ -155,6 +171,8 @@ private:
     BlockContext m_blocks;
     /// The boundaries of this rank's block (m_options.boundaries on one process).
     BoundaryOptions m_block_boundaries;
+    Eigen::Vector3d m_box_min;
+    std::array<int, 3> m_box_cells{};
     MacGrid m_grid;
     Array3<double> m_pressure;
     Array3<double> m_increment;  ///< scratch: the projection's pressure increment δ

@@ -2,6 +2,7 @@
 
 #include <mpi.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
@@ -35,7 +36,15 @@ int message_count(std::size_t count) {
     return static_cast<int>(count);
 }
 
+std::atomic<unsigned long long> g_exchanged_bytes{0};
+std::atomic<unsigned long long> g_exchanges{0};
+std::atomic<unsigned long long> g_reductions{0};
+
 }  // namespace
+
+CommunicationCounts communication_counts() {
+    return {g_exchanged_bytes.load(), g_exchanges.load(), g_reductions.load()};
+}
 
 std::mutex& mpi_lock() {
     static std::mutex lock;
@@ -115,6 +124,7 @@ double RankCommunicator::max(double value) const {
     if (!m_world)
         return value;
     double result = value;
+    ++g_reductions;
     std::lock_guard<std::mutex> guard(mpi_lock());
     check_mpi(MPI_Allreduce(&value, &result, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD),
               "MPI_Allreduce");
@@ -128,6 +138,7 @@ double RankCommunicator::min(double value) const {
 void RankCommunicator::sum_in_place(std::vector<double>& values) const {
     if (!m_world || values.empty())
         return;
+    ++g_reductions;
     std::lock_guard<std::mutex> guard(mpi_lock());
     check_mpi(MPI_Allreduce(MPI_IN_PLACE, values.data(), message_count(values.size()), MPI_DOUBLE,
                             MPI_SUM, MPI_COMM_WORLD),
@@ -151,7 +162,10 @@ std::vector<std::vector<double>> RankCommunicator::exchange(
         send_offsets[r] = message_count(send_buffer.size());
         send_counts[r] = message_count(sends[r].size());
         send_buffer.insert(send_buffer.end(), sends[r].begin(), sends[r].end());
+        if (static_cast<int>(r) != m_rank)
+            g_exchanged_bytes += sizeof(double) * sends[r].size();
     }
+    ++g_exchanges;
     std::vector<int> receive_counts(send_counts.size()), receive_offsets(send_counts.size());
     std::vector<double> receive_buffer;
     {
@@ -195,6 +209,13 @@ void RankCommunicator::barrier() const {
         return;
     std::lock_guard<std::mutex> guard(mpi_lock());
     check_mpi(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier");
+}
+
+void RankCommunicator::abort(int code) const {
+    if (!m_world)
+        return;
+    // No lock: another thread may hold it inside a collective call that will never return.
+    MPI_Abort(MPI_COMM_WORLD, code);
 }
 
 }  // namespace meniscus::fluid

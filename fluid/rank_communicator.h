@@ -25,6 +25,15 @@ bool launched_by_mpi_launcher();
 /// The lock every call into MPI or hypre holds (see the file comment).
 std::mutex& mpi_lock();
 
+/// What this process has sent to other ranks since it started (all RankCommunicator calls):
+/// personalised exchanges (halos, gathers) and reductions, for the benchmarks' bytes per step.
+struct CommunicationCounts {
+    unsigned long long exchanged_bytes = 0;  ///< sent by exchange() to other ranks
+    unsigned long long exchanges = 0;        ///< exchange() calls
+    unsigned long long reductions = 0;       ///< sum/max/min/all/broadcast calls
+};
+CommunicationCounts communication_counts();
+
 /// A group of ranks: all of MPI_COMM_WORLD, or this process alone (which makes no MPI call).
 /// Collective calls must be made by every rank in the same order.
 class RankCommunicator {
@@ -57,6 +66,9 @@ public:
     std::vector<double> broadcast(std::vector<double> values, int root) const;
     /// Waits for every rank.
     void barrier() const;
+    /// Ends every rank of the job with `code` (MPI_Abort): what a rank that cannot go on must do,
+    /// or the others wait in their next collective call for ever. One process: does nothing.
+    void abort(int code) const;
 
 private:
     RankCommunicator(bool world, int rank, int size) : m_world(world), m_rank(rank), m_size(size) {}
