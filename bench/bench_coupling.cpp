@@ -37,6 +37,7 @@
 #include "app/run.h"
 #include "app/scene.h"
 #include "app/scene_setup.h"
+#include "bench/bubble_pair_cube.h"
 #include "common/phase_clock.h"
 #include "coupling/simulation.h"
 
@@ -64,31 +65,12 @@ app::Scene refined_scene(const std::string& name, int cells) {
     return scene;
 }
 
-/// Two bubbles of radius 1.5 mm, 0.3 mm apart, in water in a 1 cm cube of `cells`³ cells.
+/// bubble_pair_cube.h's scene with MENISCUS_BENCH_SCHUR's Schur preconditioner.
 app::Scene bubble_pair_cube(int cells) {
     const char* schur_env = std::getenv("MENISCUS_BENCH_SCHUR");
     const std::string schur = schur_env != nullptr ? schur_env : "v_cycle";
-    const std::string json = R"({
-      "name": "bench_bubble_pair_cube",
-      "flow": {"type": "fluid"},
-      "domain": {"min": [0, 0, 0], "size": [0.01, 0.01, 0.01], "cells": )" +
-                             std::to_string(cells) + R"(},
-      "fluid": {"gravity": [0, 0, -9.81], "mode": "two_phase",
-                "viscous_pressure": {"preconditioner": ")" +
-                             schur + R"("}},
-      "coupling": {"edge_length_cells": 1.0, "volume_correction": true, "curvature_smoothing": 1},
-      "tracker": {"topology": {"merge_distance_fraction": 0.5}},
-      "surface": {"inside": "gas", "shape": {"type": "union", "shapes": [
-        {"type": "sphere", "center": [0.00335, 0.005, 0.004], "radius": 0.0015},
-        {"type": "sphere", "center": [0.00665, 0.005, 0.004], "radius": 0.0015}]}},
-      "initial_velocity": [
-        {"shape": {"type": "sphere", "center": [0.00335, 0.005, 0.004], "radius": 0.0015},
-         "velocity": [0.05, 0, 0]},
-        {"shape": {"type": "sphere", "center": [0.00665, 0.005, 0.004], "radius": 0.0015},
-         "velocity": [-0.05, 0, 0]}],
-      "time": {"end": 0.01, "frames": 1}
-    })";
-    return app::parse_scene(json, "bench_coupling.cpp", ".");
+    return bench::bubble_pair_cube(cells,
+                                   R"("viscous_pressure": {"preconditioner": ")" + schur + R"("})");
 }
 
 /// Phase seconds summed over the timed steps.

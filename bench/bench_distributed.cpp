@@ -31,6 +31,7 @@
 
 #include "app/scene.h"
 #include "app/scene_setup.h"
+#include "bench/bubble_pair_cube.h"
 #include "coupling/rasterize.h"
 #include "coupling/simulation.h"
 #include "coupling/surface_tension.h"
@@ -59,30 +60,9 @@ double peak_rss_mb() {
     return 0.0;
 }
 
-app::Scene bubble_pair_cube(int cells) {
-    const std::string json = R"({
-      "name": "bench_bubble_pair_cube",
-      "flow": {"type": "fluid"},
-      "domain": {"min": [0, 0, 0], "size": [0.01, 0.01, 0.01], "cells": )" +
-                             std::to_string(cells) + R"(},
-      "fluid": {"gravity": [0, 0, -9.81], "mode": "two_phase", "pressure_solver": "hypre_pfmg_pcg"},
-      "coupling": {"edge_length_cells": 1.0, "volume_correction": true, "curvature_smoothing": 1},
-      "tracker": {"topology": {"merge_distance_fraction": 0.5}},
-      "surface": {"inside": "gas", "shape": {"type": "union", "shapes": [
-        {"type": "sphere", "center": [0.00335, 0.005, 0.004], "radius": 0.0015},
-        {"type": "sphere", "center": [0.00665, 0.005, 0.004], "radius": 0.0015}]}},
-      "initial_velocity": [
-        {"shape": {"type": "sphere", "center": [0.00335, 0.005, 0.004], "radius": 0.0015},
-         "velocity": [0.05, 0, 0]},
-        {"shape": {"type": "sphere", "center": [0.00665, 0.005, 0.004], "radius": 0.0015},
-         "velocity": [-0.05, 0, 0]}],
-      "time": {"end": 0.01, "frames": 1}
-    })";
-    return app::parse_scene(json, "bench_distributed.cpp", ".");
-}
-
 std::unique_ptr<coupling::Simulation> make_simulation(int cells) {
-    const app::Scene scene = bubble_pair_cube(cells);
+    const app::Scene scene =
+        bench::bubble_pair_cube(cells, R"("pressure_solver": "hypre_pfmg_pcg")");
     std::string report;
     double xi = 0.0;
     tracker::SurfaceMesh initial = app::build_initial_surface(scene, &report, &xi);

@@ -122,6 +122,30 @@ TEST(HaloExchange, GhostLayersHoldTheirOwnersValues) {
     }
 }
 
+/// The largest |value| of `expected` and the largest |actual − expected| over their elements.
+struct Deviation {
+    double scale = 0.0, difference = 0.0;
+};
+Deviation deviation(const std::vector<double>& actual, const std::vector<double>& expected) {
+    Deviation d;
+    for (std::size_t e = 0; e < expected.size(); ++e) {
+        d.scale = std::max(d.scale, std::abs(expected[e]));
+        d.difference = std::max(d.difference, std::abs(actual[e] - expected[e]));
+    }
+    return d;
+}
+/// The same over the three velocity components of two grids.
+Deviation deviation(const MacGrid& actual, const MacGrid& expected) {
+    Deviation d;
+    for (int axis = 0; axis < 3; ++axis) {
+        const Deviation one =
+            deviation(actual.velocity(axis).storage(), expected.velocity(axis).storage());
+        d.scale = std::max(d.scale, one.scale);
+        d.difference = std::max(d.difference, one.difference);
+    }
+    return d;
+}
+
 PhaseOptions water_and_air() {
     PhaseOptions phases;
     phases.rho_liquid = 1000.0;
@@ -202,21 +226,11 @@ void expect_projection_matches(const ProjectionCase& c) {
 
     // The block, ghost layers included, against the same layers of the whole grid.
     const Array3<double> p_expected = extract_block(p_whole, d, rank, LayerKind::cells);
-    double p_scale = 0.0, p_difference = 0.0;
-    for (std::size_t e = 0; e < p_expected.size(); ++e) {
-        p_scale = std::max(p_scale, std::abs(p_expected[e]));
-        p_difference = std::max(p_difference, std::abs(p_block[e] - p_expected[e]));
-    }
-    EXPECT_LE(p_difference, AGREEMENT * p_scale) << c.name << ", rank " << rank;
-    const MacGrid expected = extract_block_grid(reference, d, rank);
-    double u_scale = 0.0, u_difference = 0.0;
-    for (int axis = 0; axis < 3; ++axis)
-        for (std::size_t e = 0; e < expected.velocity(axis).size(); ++e) {
-            u_scale = std::max(u_scale, std::abs(expected.velocity(axis)[e]));
-            u_difference = std::max(u_difference,
-                                    std::abs(block.velocity(axis)[e] - expected.velocity(axis)[e]));
-        }
-    EXPECT_LE(u_difference, AGREEMENT * u_scale) << c.name << ", rank " << rank;
+    const Deviation p = deviation(p_block.storage(), p_expected.storage());
+    EXPECT_LE(p.difference, AGREEMENT * p.scale) << c.name << ", rank " << rank;
+    const Deviation u = deviation(block, extract_block_grid(reference, d, rank));
+    EXPECT_LE(u.difference, AGREEMENT * u.scale) << c.name << ", rank " << rank;
+    const double u_scale = u.scale;
 
     // The velocities gathered on rank 0 are the whole grid's.
     MacGrid gathered(nx, ny, nz, DX);
@@ -289,15 +303,8 @@ void expect_viscosity_matches(bool periodic_z, BoundaryType walls) {
     if (d.distributed()) {  // the same Krylov iteration, summed in another order
         EXPECT_NEAR(distributed.iterations, serial.iterations, 2);
     }
-    const MacGrid expected = extract_block_grid(reference, d, rank);
-    double scale = 0.0, difference = 0.0;
-    for (int axis = 0; axis < 3; ++axis)
-        for (std::size_t e = 0; e < expected.velocity(axis).size(); ++e) {
-            scale = std::max(scale, std::abs(expected.velocity(axis)[e]));
-            difference = std::max(difference,
-                                  std::abs(block.velocity(axis)[e] - expected.velocity(axis)[e]));
-        }
-    EXPECT_LE(difference, AGREEMENT * scale) << "rank " << rank;
+    const Deviation u = deviation(block, extract_block_grid(reference, d, rank));
+    EXPECT_LE(u.difference, AGREEMENT * u.scale) << "rank " << rank;
 }
 
 TEST(DistributedViscosity, BubbleInAViscousLiquidBetweenNoSlipWalls) {
@@ -371,24 +378,13 @@ void expect_steps_match(const StepCase& c) {
         EXPECT_TRUE(a.pressure.converged && b.pressure.converged) << c.name;
         EXPECT_EQ(a.passes, b.passes) << c.name << ", step " << step;
     }
-    const MacGrid expected = extract_block_grid(whole.grid(), d, world.rank());
-    double scale = 0.0, difference = 0.0;
-    for (int axis = 0; axis < 3; ++axis)
-        for (std::size_t e = 0; e < expected.velocity(axis).size(); ++e) {
-            scale = std::max(scale, std::abs(expected.velocity(axis)[e]));
-            difference = std::max(
-                difference, std::abs(split.grid().velocity(axis)[e] - expected.velocity(axis)[e]));
-        }
-    EXPECT_GT(scale, 0.0);
-    EXPECT_LE(difference, AGREEMENT * scale) << c.name << ", rank " << world.rank();
-    const Array3<double> p_expected =
-        extract_block(whole.pressure(), d, world.rank(), LayerKind::cells);
-    double p_scale = 0.0, p_difference = 0.0;
-    for (std::size_t e = 0; e < p_expected.size(); ++e) {
-        p_scale = std::max(p_scale, std::abs(p_expected[e]));
-        p_difference = std::max(p_difference, std::abs(split.pressure()[e] - p_expected[e]));
-    }
-    EXPECT_LE(p_difference, AGREEMENT * p_scale) << c.name << ", rank " << world.rank();
+    const Deviation u = deviation(split.grid(), extract_block_grid(whole.grid(), d, world.rank()));
+    EXPECT_GT(u.scale, 0.0);
+    EXPECT_LE(u.difference, AGREEMENT * u.scale) << c.name << ", rank " << world.rank();
+    const Deviation p =
+        deviation(split.pressure().storage(),
+                  extract_block(whole.pressure(), d, world.rank(), LayerKind::cells).storage());
+    EXPECT_LE(p.difference, AGREEMENT * p.scale) << c.name << ", rank " << world.rank();
 }
 
 TEST(DistributedFluidSolver, CoupledViscousBubbleStepsAsOnOneProcess) {
