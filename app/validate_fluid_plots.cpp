@@ -156,6 +156,31 @@ if "B5" in b:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     save(fig, "b5_volume.png")
+    studies = [r for r in b["B5"]["runs"] if "convergence" in r]
+    if studies:
+        # The time of the first topology change against the cells (at the own dt) and against dt
+        # (at the scene's cells), relative to the finest value of each axis: no exact reference.
+        fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.5))
+        for r in studies:
+            runs = r["convergence"]["runs"]
+            space = sorted([v for v in runs if v["dt_factor"] == 1], key=lambda v: v["cells"])
+            time = sorted([v for v in runs if v["cells_scale"] == 1], key=lambda v: -v["dt_factor"])
+            order = r["convergence"].get("space_order")
+            ax.plot([v["cells"] for v in space], [1e3 * v["event_time"] for v in space], "o-", ms=4,
+                    label="%s%s" % (r["scene"], "" if order is None else " (order %.2g)" % order))
+            order = r["convergence"].get("time_order")
+            bx.semilogx([v["dt_factor"] for v in time], [1e3 * v["event_time"] for v in time], "o-",
+                        ms=4, label="%s%s" % (r["scene"], "" if order is None else " (order %.2g)" % order))
+        ax.set_xlabel("cells along the scene's x axis (own dt)")
+        ax.set_ylabel("time of the first merge or pinch-off (ms)")
+        ax.set_title("B5 topology change against resolution")
+        bx.set_xlabel("dt factor (scene's cells)")
+        bx.set_ylabel("time of the first merge or pinch-off (ms)")
+        bx.set_title("B5 topology change against the time step")
+        for a in (ax, bx):
+            a.grid(True, which="both", alpha=0.3)
+            a.legend(fontsize=7)
+        save(fig, "b5_convergence.png")
 
 if "B6" in b:
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.5))

@@ -294,7 +294,8 @@ void merge_scenes_case(CaseContext& context, std::ostringstream& md) {
         md << r["scene"].get<std::string>() << ": observed order in Δt " << text(c["time_order"])
            << ", in Δx " << text(c["space_order"]) << ".  \n";
     }
-    md << "\nPlot: b5_volume.png.\n\n";
+    md << "\nPlots: b5_volume.png, b5_convergence.png (the topology change against the cells and "
+          "against Δt).\n\n";
 }
 
 }  // namespace meniscus::app::validate_fluid
