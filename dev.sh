@@ -29,6 +29,7 @@ SANITIZE_EXCLUDE+='|CcdFalsePositives\.NearDegenerate|RemeshAccuracy\.SplitsAtTh
 SANITIZE_EXCLUDE+='|MovingWalls\.LidOverAClosedChannel|FluidSolver\.TaylorGreenVortexDecay|DropMerge\.TwoDrops|SurfaceTension\.(StaticDropThrough|SmoothingReduces)'
 SANITIZE_EXCLUDE+='|FuzzRun.*/[1-6]$|RenderPath|FluidScenes\.TimeDtCapsTheFluidStep'
 SANITIZE_EXCLUDE+='|Resume\.(FluidRunKilled|GeometricFlowKilled|OneAndTwoThreads)'
+SANITIZE_EXCLUDE+='|DistributedRun\.(BubbleMerge|JetPinch)'
 # Any finding ends the program with exit code 86 (tests then fail); LeakSanitizer included.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-exitcode=86:detect_leaks=1:strict_string_checks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-exitcode=86:print_stacktrace=1}

@@ -788,7 +788,11 @@ static void run_geometric_scene(const Scene& scene, const RunOptions& options,
 
 RunResult run_scene(const Scene& scene, const RunOptions& options, const std::atomic<bool>& stop) {
     Scene stoppable = scene;
-    stoppable.cancel = CancellationToken(&stop);
+    // On several MPI ranks nothing is cancelled half-way (a rank that left a step alone would
+    // leave the others waiting in their next collective call): the ranks agree to stop between
+    // steps instead (run_fluid_scene()).
+    if (options.ranks.size() <= 1)
+        stoppable.cancel = CancellationToken(&stop);
     RunResult result;
     try {
         if (scene.flow.type == "fluid")

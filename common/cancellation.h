@@ -29,6 +29,8 @@ public:
     /// A token that is requested once `*flag` becomes true.
     explicit CancellationToken(const std::atomic<bool>* flag) : m_flag(flag) {}
 
+    /// True when the token is tied to a flag (it may be requested some day).
+    bool can_be_requested() const { return m_flag != nullptr; }
     /// True once the owner asked to stop.
     bool requested() const { return m_flag != nullptr && m_flag->load(std::memory_order_relaxed); }
     /// Throws Cancelled("cancelled in <where>") when requested().

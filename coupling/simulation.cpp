@@ -251,14 +251,21 @@ void Simulation::combine_rank_velocities(std::vector<tracker::Vec3>& velocities)
     const fluid::SlabDecomposition& d = blocks.decomposition();
     const tracker::SurfaceMesh& mesh = m_tracker->mesh();
     const double z0 = m_fluid.box_min().z(), dx = m_fluid.grid().dx();
+    // The replicated meshes must agree before the reduction is sized by them.
+    const double vertices = static_cast<double>(velocities.size());
+    if (blocks.max(vertices) != blocks.min(vertices))
+        throw std::runtime_error(
+            "Simulation: the ranks' copies of the surface mesh differ in their vertex count (the "
+            "replicated tracker was not deterministic)");
     std::vector<double> flat(3 * velocities.size(), 0.0);
     for (size_t v = 0; v < velocities.size(); ++v) {
         if (!mesh.vertex_alive(static_cast<int>(v)))
             continue;
-        int layer =
-            static_cast<int>(std::floor((mesh.position(static_cast<int>(v)).z() - z0) / dx));
-        if (!d.periodic())
-            layer = std::clamp(layer, 0, d.layers() - 1);
+        // Clamped on a periodic z too: the tracker keeps positions in [z0, z0 + L), but the
+        // division may round a position just below z0 + L up to layer nz.
+        const int layer = std::clamp(
+            static_cast<int>(std::floor((mesh.position(static_cast<int>(v)).z() - z0) / dx)), 0,
+            d.layers() - 1);
         if (d.owner(layer) != blocks.rank())
             continue;
         for (int a = 0; a < 3; ++a)

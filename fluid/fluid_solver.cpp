@@ -85,9 +85,17 @@ FluidSolver::FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3
                   RankCommunicator::self()) {}
 
 int FluidSolver::ghost_layers_needed(const FluidOptions& options) {
+    // Each advection reads up to cfl_number cells back plus its interpolation stencil; MacCormack
+    // advects twice, BFECC three times, each from the previous one's result.
     const int reach = static_cast<int>(std::ceil(options.time_step.cfl_number)) + 1;
-    const int traces = options.advection.scheme == AdvectionScheme::semi_lagrangian ? 1 : 2;
-    return std::max(traces * reach + 1, 2);
+    const int traces = options.advection.scheme == AdvectionScheme::semi_lagrangian ? 1
+                       : options.advection.scheme == AdvectionScheme::maccormack    ? 2
+                                                                                    : 3;
+    int layers = std::max(traces * reach + 1, 2);  // 2: the viscous stencil (cell and edge)
+    // Free surface: each extrapolation pass moves the wrong values at a block's end one layer in.
+    if (options.mode == FluidMode::free_surface)
+        layers = std::max(layers, options.extrapolation_layers + 1);
+    return layers;
 }
 
 FluidSolver::FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3d& origin,
@@ -107,6 +115,11 @@ FluidSolver::FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3
                                     std::to_string(decomposition.layers()) +
                                     " z-layers, the grid has " + std::to_string(nz));
     if (decomposition.distributed()) {
+        if (m_options.pressure.iteration.cancel.can_be_requested() ||
+            m_options.viscosity.iteration.cancel.can_be_requested())
+            throw std::invalid_argument(
+                "FluidSolver: the solves cannot be cancelled on several ranks (a rank leaving a "
+                "solve alone would leave the others waiting); stop between steps instead");
         if (decomposition.periodic() != b.periodic(2))
             throw std::invalid_argument(
                 "FluidSolver: the decomposition and boundaries/z disagree on a periodic z");
