@@ -190,6 +190,7 @@ int command_run(const std::vector<std::string>& args) {
         options.ranks = meniscus::fluid::RankCommunicator::world();
         if (options.ranks.size() > 1) {
             g_distributed_run = true;
+            options.limits.ranks = options.ranks.size();
             if (options.ranks.rank() != 0)
                 options.quiet = true;
         }

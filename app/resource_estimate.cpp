@@ -1,5 +1,7 @@
 #include "app/resource_estimate.h"
 
+#include "fluid/fluid_solver.h"
+
 #include "app/errors.h"
 
 #include <unistd.h>
@@ -120,8 +122,8 @@ SurfaceSize shape_surface_size(const Scene& scene) {
     return s;
 }
 
-ResourceEstimate estimate_resources(const Scene& scene, const SurfaceSize& surface,
-                                    double frame_dt) {
+ResourceEstimate estimate_resources(const Scene& scene, const SurfaceSize& surface, double frame_dt,
+                                    int ranks) {
     ResourceEstimate e;
     const double xi = scene.surface.edge_length;
     e.initial_triangles = surface.triangles > 0.0
@@ -163,10 +165,28 @@ ResourceEstimate estimate_resources(const Scene& scene, const SurfaceSize& surfa
     if (scene.flow.type == "fluid") {
         const Eigen::Vector3d n = domain_cells(scene);
         const double cells = n.prod();
-        e.memory.push_back({"fluid grid of " + format_number(n.x()) + " x " + format_number(n.y()) +
-                                " x " + format_number(n.z()) + " cells (/domain)",
-                            cells * FLUID_BYTES_PER_CELL +
-                                (scene.output.vdb ? cells * VDB_BYTES_PER_FLUID_CELL : 0.0)});
+        if (ranks > 1) {
+            // One rank's slab of z-layers with its ghost layers (at most 2 × 5 with MacCormack at
+            // CFL 1; fluid::FluidSolver::ghost_layers_needed()), and on rank 0 the whole grid's
+            // velocities and pressure gathered for the VDB (4 doubles per cell).
+            const double layers =
+                std::min(n.z(), std::ceil(n.z() / ranks) +
+                                    2.0 * fluid::FluidSolver::ghost_layers_needed(scene.fluid));
+            const double rank_cells = n.x() * n.y() * layers;
+            e.memory.push_back(
+                {"one of " + std::to_string(ranks) + " MPI ranks' slab of the fluid grid of " +
+                     format_number(n.x()) + " x " + format_number(n.y()) + " x " +
+                     format_number(n.z()) + " cells (/domain): " + format_number(layers) +
+                     " z-layers",
+                 rank_cells * FLUID_BYTES_PER_CELL +
+                     (scene.output.vdb ? cells * (VDB_BYTES_PER_FLUID_CELL + 32.0) : 0.0)});
+        } else {
+            e.memory.push_back({"fluid grid of " + format_number(n.x()) + " x " +
+                                    format_number(n.y()) + " x " + format_number(n.z()) +
+                                    " cells (/domain)",
+                                cells * FLUID_BYTES_PER_CELL +
+                                    (scene.output.vdb ? cells * VDB_BYTES_PER_FLUID_CELL : 0.0)});
+        }
         // Steps: dt = min(max_dt, capillary, CFL) (coupling::Simulation::step), the capillary
         // limit with the smaller of dx and the edge length, the CFL limit with the initial speed
         // plus what gravity adds over the frame.

@@ -17,6 +17,9 @@ namespace meniscus::app {
 struct ResourceLimits {
     double max_memory_bytes = 0.0;           ///< 0 = default_max_memory_bytes()
     double max_steps_per_frame = 100000.0;   ///< estimated time steps in one frame
+    /// MPI ranks the fluid grid is split over (mpirun): the memory estimate is one rank's, the
+    /// largest (rank 0, which also gathers the grids the VDB files need).
+    int ranks = 1;
 };
 
 /// Half the machine's physical memory (bytes): the default of --max-memory.
@@ -61,9 +64,10 @@ struct SurfaceSize {
 SurfaceSize shape_surface_size(const Scene& scene);
 
 /// Estimates memory and steps per frame of `scene` with `surface`; `frame_dt` is the time per
-/// frame (s).
-ResourceEstimate estimate_resources(const Scene& scene, const SurfaceSize& surface,
-                                    double frame_dt);
+/// frame (s). On `ranks` MPI ranks the fluid grid's part is one rank's slab with its ghost
+/// layers, plus, with VDB output, the whole grid's velocities and pressure gathered on rank 0.
+ResourceEstimate estimate_resources(const Scene& scene, const SurfaceSize& surface, double frame_dt,
+                                    int ranks = 1);
 
 /// Throws InputError (exit 2) naming the scene file, the keys behind the estimate and the
 /// option that raises the limit when `estimate` exceeds `limits`.

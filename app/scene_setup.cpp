@@ -271,7 +271,7 @@ SurfaceMesh checked_initial_surface(const Scene& scene, const ResourceLimits& li
             size.bounds.extend(p);
     }
     const double frame_dt = scene.time.end / scene.time.frames;
-    check_resources(scene, estimate_resources(scene, size, frame_dt), limits);
+    check_resources(scene, estimate_resources(scene, size, frame_dt, limits.ranks), limits);
     check_scene_scale(scene);
     if (scene.shape) {
         const tracker::Box3 b = scene.shape->bounds();

@@ -96,7 +96,9 @@ std::pair<double, double> pressure_difference(const fs::path& a, const fs::path&
 /// The one-process run of `scene` against the run on `ranks` ranks.
 void expect_same_run(const std::string& name, const Json& scene, int ranks,
                      int expected_final_components) {
-    const fs::path dir = fs::temp_directory_path() / "meniscus_distributed_run";
+    // One folder per case: ctest runs the tests of this program in parallel.
+    const fs::path dir = fs::temp_directory_path() /
+                         ("meniscus_distributed_run_" + name + "_" + std::to_string(ranks));
     const fs::path alone = dir / (name + "_alone"),
                    split = dir / (name + "_" + std::to_string(ranks));
     const ChildResult a = run(scene, alone, 0);
