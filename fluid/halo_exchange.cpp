@@ -35,6 +35,16 @@ bool owns(const SlabDecomposition& d, int rank, int g, LayerKind kind) {
     return kind == LayerKind::z_faces && !d.periodic() && rank == d.ranks() - 1 && g == d.layers();
 }
 
+/// True when the ghost layer at unwrapped position `g` of `rank`'s block lies within `depth`
+/// layers of its own (depth ≤ 0: every ghost layer).
+bool within(const SlabDecomposition& d, int rank, int g, int depth) {
+    if (depth <= 0)
+        return true;
+    const int distance =
+        g < d.owned_begin(rank) ? d.owned_begin(rank) - g : g - d.owned_end(rank) + 1;
+    return distance <= depth;
+}
+
 /// The layer of `rank`'s block holding the owned copy of global layer `w` (wrapped).
 int owned_position(const SlabDecomposition& d, int rank, int w) {
     return w - d.local_begin(rank);
@@ -60,7 +70,7 @@ int block_layers(const SlabDecomposition& decomposition, int rank, LayerKind kin
 }
 
 void exchange_halos(Array3<double>& block, const SlabDecomposition& d,
-                    const RankCommunicator& ranks, LayerKind kind) {
+                    const RankCommunicator& ranks, LayerKind kind, int depth) {
     const int me = ranks.rank();
     if (d.ranks() != ranks.size())
         throw std::invalid_argument("exchange_halos: a decomposition over " +
@@ -75,7 +85,7 @@ void exchange_halos(Array3<double>& block, const SlabDecomposition& d,
     for (int r = 0; r < d.ranks(); ++r)
         for (int layer = 0; layer < block_layers(d, r, kind); ++layer) {
             const int g = d.local_begin(r) + layer;
-            if (owns(d, r, g, kind) || owner_of(d, g, kind) != me)
+            if (owns(d, r, g, kind) || owner_of(d, g, kind) != me || !within(d, r, g, depth))
                 continue;
             const double* from = block.data() + size * static_cast<std::size_t>(owned_position(
                                                            d, me, wrapped(d, g, kind)));
@@ -86,7 +96,7 @@ void exchange_halos(Array3<double>& block, const SlabDecomposition& d,
     std::vector<std::size_t> read(received.size(), 0);
     for (int layer = 0; layer < block.nk(); ++layer) {
         const int g = d.local_begin(me) + layer;
-        if (owns(d, me, g, kind))
+        if (owns(d, me, g, kind) || !within(d, me, g, depth))
             continue;
         const std::size_t from = static_cast<std::size_t>(owner_of(d, g, kind));
         if (read[from] + size > received[from].size())

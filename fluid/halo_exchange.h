@@ -20,8 +20,10 @@ int block_layers(const SlabDecomposition& decomposition, int rank, LayerKind kin
 /// Collective: fills every ghost layer of `block` (this rank's block of a field of `kind`) with
 /// the owner's values of that layer. Owned layers are sent, never changed. Throws
 /// std::invalid_argument when `block` does not have block_layers() z-layers.
+/// `depth` > 0: only the ghost layers within `depth` layers of the rank's own (what a stencil of
+/// that reach reads; the viscous CG refreshes 2 of 5 every iteration).
 void exchange_halos(Array3<double>& block, const SlabDecomposition& decomposition,
-                    const RankCommunicator& ranks, LayerKind kind);
+                    const RankCommunicator& ranks, LayerKind kind, int depth = 0);
 
 /// `rank`'s block of a field that is held whole (nz or nz + 1 z-layers): its layers, ghosts
 /// included, wrapped around a periodic z.
