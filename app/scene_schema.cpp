@@ -141,8 +141,8 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
                 {"mic0_pcg", fluid::PressureSolver::mic0_pcg},
                 {"eigen_ic_cg", fluid::PressureSolver::eigen_ic_cg},
                 {"hypre_pfmg_pcg", fluid::PressureSolver::hypre_pfmg_pcg}},
-               "pressure Poisson solver (hypre_pfmg_pcg: hypre's PCG with a PFMG V-cycle, on one "
-               "MPI process)");
+               "pressure Poisson solver (hypre_pfmg_pcg: hypre's PCG with a PFMG V-cycle; under "
+               "mpirun with several ranks hypre is always used)");
     v.number("pressure_tolerance", o.pressure.iteration.tolerance, Range{0.0, 1.0, true, true}, "",
              "relative residual of the pressure solve");
     v.integer("pressure_max_iterations", o.pressure.iteration.max_iterations,

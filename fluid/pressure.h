@@ -44,8 +44,8 @@ enum class PressureSolver {
     mic0_pcg,       ///< PCG with the MIC(0) preconditioner (sequential preconditioner)
     multigrid_pcg,  ///< PCG with a multigrid V-cycle preconditioner (TBB-parallel)
     eigen_ic_cg,    ///< reference: Eigen ConjugateGradient + IncompleteCholesky on a CSR copy
-    /// hypre (libhypre-dev) on one MPI process: HYPRE_StructPCG preconditioned by one
-    /// HYPRE_StructPFMG V-cycle (fluid/hypre_pressure.h; initialises MPI on first use)
+    /// hypre (libhypre-dev): HYPRE_StructPCG preconditioned by one HYPRE_StructPFMG V-cycle
+    /// (fluid/hypre_pressure.h; initialises MPI on first use). Always used on several ranks.
     hypre_pfmg_pcg
 };
 

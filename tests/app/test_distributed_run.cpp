@@ -1,10 +1,10 @@
 // `mpirun -n K meniscus run SCENE` (issue 40) against the same binary on one process: the grid
 // split into slabs of z-layers across the interface, the mesh replicated, rank 0 writing. Quick
-// variants of a static drop, bubble_merge and jet_pinch; both runs solve the pressure with hypre
-// (the distributed backend), so they differ only by where the sums are taken. Checked per frame:
-// the vertex positions within 1e-9 of the domain size, the same component counts (the same
-// merge and pinch frames), steps and volumes, the VDB pressure assembled from the blocks. The
-// positions are compared up to the first merge or pinch-off (see expect_same_run()).
+// variants of a static drop, bubble_merge and jet_pinch, each on 2 and 3 ranks; both runs solve the
+// pressure with hypre (the distributed backend), so they differ only by where the sums are taken.
+// Checked per frame: the vertex positions within 1e-9 of the domain size, the same component counts
+// (the same merge and pinch frames), steps and volumes, the VDB pressure assembled from the blocks.
+// The positions are compared up to the first merge or pinch-off (see expect_same_run()).
 #include "child_process.h"
 
 #include <gtest/gtest.h>
@@ -176,6 +176,7 @@ TEST(DistributedRun, BubbleMergeMergesAtTheSameFrame) {
     scene["time"] = {{"end", 0.012}, {"frames", 12}};
     scene["output"] = {{"ply", true}, {"vdb", false}};
     expect_same_run("bubble_merge", scene, 2, 1);
+    expect_same_run("bubble_merge", scene, 3, 1);
 }
 
 TEST(DistributedRun, JetPinchPinchesAtTheSameFrame) {
@@ -194,6 +195,7 @@ TEST(DistributedRun, JetPinchPinchesAtTheSameFrame) {
     scene["time"] = {{"end", 0.014}, {"frames", 14}};
     scene["output"] = {{"ply", true}, {"vdb", false}};
     expect_same_run("jet_pinch", scene, 2, 2);
+    expect_same_run("jet_pinch", scene, 3, 2);
 }
 
 TEST(DistributedRun, RefusesWhatIsNotDistributedYet) {
