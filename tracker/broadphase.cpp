@@ -253,22 +253,10 @@ inline bool boxes_overlap(const Box3d& a, const Box3d& b) {
     return x & y & z;
 }
 
-std::uint64_t mix(std::int64_t key) {
-    std::uint64_t x = static_cast<std::uint64_t>(key);
-    x ^= x >> 33;
-    x *= 0xff51afd7ed558ccdULL;
-    x ^= x >> 33;
-    return x;
-}
-
 }  // namespace
 
 std::int64_t LooseGrid::cell_key(const Eigen::Array3i& c) const {
-    // 21 bits per axis (offset into the non-negative range); distinct cells may alias only when
-    // the grid is more than two million cells wide, which merges lists (still a superset).
-    constexpr std::int64_t MASK = (1 << 21) - 1, OFFSET = 1 << 20;
-    return ((c.x() + OFFSET) & MASK) | (((c.y() + OFFSET) & MASK) << 21) |
-           (((c.z() + OFFSET) & MASK) << 42);
+    return SpatialHash::key(c.x(), c.y(), c.z());
 }
 
 LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
@@ -366,7 +354,7 @@ LooseGrid::LooseGrid(const std::vector<Box3d>& boxes) : m_boxes(boxes) {
 
 size_t LooseGrid::hash_slot(std::int64_t key) const {
     const size_t mask = m_slot_key.size() - 1;
-    size_t slot = mix(key) & mask;
+    size_t slot = SpatialHash::mix_key(key) & mask;
     while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
         slot = (slot + 1) & mask;
     return slot;

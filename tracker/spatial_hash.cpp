@@ -21,7 +21,9 @@ constexpr double SPATIAL_HASH_MAX_LOAD = 0.5;
 constexpr std::int64_t CELL_BITS_MASK = (1 << 21) - 1;
 constexpr std::int64_t CELL_OFFSET = 1 << 20;
 
-std::uint64_t mix_key(std::int64_t key) {
+}  // namespace
+
+std::uint64_t SpatialHash::mix_key(std::int64_t key) {
     std::uint64_t x = static_cast<std::uint64_t>(key);
     x ^= x >> 33;
     x *= 0xff51afd7ed558ccdULL;
@@ -29,25 +31,25 @@ std::uint64_t mix_key(std::int64_t key) {
     return x;
 }
 
-}  // namespace
-
 std::int64_t SpatialHash::key(int i, int j, int k) {
     return ((static_cast<std::int64_t>(i) + CELL_OFFSET) & CELL_BITS_MASK) |
            (((static_cast<std::int64_t>(j) + CELL_OFFSET) & CELL_BITS_MASK) << 21) |
            (((static_cast<std::int64_t>(k) + CELL_OFFSET) & CELL_BITS_MASK) << 42);
 }
 
+size_t SpatialHash::probe(std::int64_t key) const {
+    const size_t mask = m_slot_key.size() - 1;
+    size_t slot = mix_key(key) & mask;
+    while (m_slot_key[slot] != -1 && m_slot_key[slot] != key)
+        slot = (slot + 1) & mask;
+    return slot;
+}
+
 int SpatialHash::find_slot(std::int64_t key) const {
     if (m_slot_key.empty())
         return -1;
-    const size_t mask = m_slot_key.size() - 1;
-    size_t slot = mix_key(key) & mask;
-    while (m_slot_key[slot] != -1) {
-        if (m_slot_key[slot] == key)
-            return static_cast<int>(slot);
-        slot = (slot + 1) & mask;
-    }
-    return -1;
+    const size_t slot = probe(key);
+    return m_slot_key[slot] == key ? static_cast<int>(slot) : -1;
 }
 
 void SpatialHash::grow() {
@@ -56,13 +58,10 @@ void SpatialHash::grow() {
     std::vector<int> old_head(slots, -1);
     old_key.swap(m_slot_key);
     old_head.swap(m_slot_head);
-    const size_t mask = slots - 1;
     for (size_t i = 0; i < old_key.size(); ++i) {
         if (old_key[i] == -1)
             continue;
-        size_t slot = mix_key(old_key[i]) & mask;
-        while (m_slot_key[slot] != -1)
-            slot = (slot + 1) & mask;
+        const size_t slot = probe(old_key[i]);  // keys are distinct: a free slot
         m_slot_key[slot] = old_key[i];
         m_slot_head[slot] = old_head[i];
     }
@@ -72,13 +71,9 @@ int SpatialHash::find_or_add_slot(std::int64_t key) {
     if (static_cast<double>(m_used_slots + 1) >
         SPATIAL_HASH_MAX_LOAD * static_cast<double>(m_slot_key.size()))
         grow();
-    const size_t mask = m_slot_key.size() - 1;
-    size_t slot = mix_key(key) & mask;
-    while (m_slot_key[slot] != -1) {
-        if (m_slot_key[slot] == key)
-            return static_cast<int>(slot);
-        slot = (slot + 1) & mask;
-    }
+    const size_t slot = probe(key);
+    if (m_slot_key[slot] == key)
+        return static_cast<int>(slot);
     m_slot_key[slot] = key;
     m_slot_head[slot] = -1;
     ++m_used_slots;

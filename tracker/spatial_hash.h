@@ -34,13 +34,22 @@ public:
     double cell_size() const { return m_cell; }
     void clear();
 
+    /// The key of cell (i, j, k): 21 bits per axis, offset into the non-negative range (cells
+    /// more than about a million apart may alias, which only merges lists: a superset). Also the
+    /// static broad phase's cell key (LooseGrid).
+    static std::int64_t key(int i, int j, int k);
+    /// The hash of a cell key that picks its first slot in an open-addressing table.
+    static std::uint64_t mix_key(std::int64_t key);
+
 private:
     struct CellRange {
         Eigen::Array3i lo, hi;
         bool oversized = false;
     };
     CellRange cells_of(const Box3d& box) const;
-    static std::int64_t key(int i, int j, int k);
+    /// The slot holding `key`, or the free slot where linear probing from its hash ends (the
+    /// table must not be empty).
+    size_t probe(std::int64_t key) const;
     /// Slot of `key` in the open-addressing table, or −1 when absent.
     int find_slot(std::int64_t key) const;
     /// Slot of `key`, added (with an empty list) when absent; may grow the table.
