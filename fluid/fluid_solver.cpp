@@ -150,9 +150,6 @@ ProjectionResult FluidSolver::projection(MacGrid& grid, const InterfaceInput& in
                                          const PhaseOptions& phases, double dt,
                                          Array3<double>& pressure,
                                          const BoundaryOptions& boundaries) const {
-    if (!m_blocks.distributed())
-        return project(grid, interface, phases, m_options.mode, dt, m_options.pressure, pressure,
-                       boundaries);
     return project_block(grid, interface, phases, m_options.mode, dt, m_options.pressure, pressure,
                          boundaries, m_blocks.decomposition(), m_blocks.ranks());
 }

@@ -162,7 +162,7 @@ private:
     /// The incremental and coupled schemes.
     void incremental_step(double dt, const InterfaceInput& interface, StepResult& result);
 
-    /// project() or, on several ranks, project_block() with the whole box's `boundaries`.
+    /// project_block() (project() on one process) with the whole box's `boundaries`.
     ProjectionResult projection(MacGrid& grid, const InterfaceInput& interface,
                                 const PhaseOptions& phases, double dt, Array3<double>& pressure,
                                 const BoundaryOptions& boundaries) const;

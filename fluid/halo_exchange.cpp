@@ -71,15 +71,19 @@ int block_layers(const SlabDecomposition& decomposition, int rank, LayerKind kin
 
 void exchange_halos(Array3<double>& block, const SlabDecomposition& d,
                     const RankCommunicator& ranks, LayerKind kind, int depth) {
+    check_block(block, d, ranks.rank(), kind, "exchange_halos");
+    exchange_halo_layers(block.data(), layer_size(block), d, ranks, kind, depth);
+}
+
+void exchange_halo_layers(double* block, std::size_t size, const SlabDecomposition& d,
+                          const RankCommunicator& ranks, LayerKind kind, int depth) {
     const int me = ranks.rank();
     if (d.ranks() != ranks.size())
         throw std::invalid_argument("exchange_halos: a decomposition over " +
                                     std::to_string(d.ranks()) + " ranks on " +
                                     std::to_string(ranks.size()));
-    check_block(block, d, me, kind, "exchange_halos");
     if (!d.distributed())
         return;
-    const std::size_t size = layer_size(block);
     // What every rank needs from this one, in the order of its block's layers.
     std::vector<std::vector<double>> sends(static_cast<std::size_t>(d.ranks()));
     for (int r = 0; r < d.ranks(); ++r)
@@ -87,14 +91,14 @@ void exchange_halos(Array3<double>& block, const SlabDecomposition& d,
             const int g = d.local_begin(r) + layer;
             if (owns(d, r, g, kind) || owner_of(d, g, kind) != me || !within(d, r, g, depth))
                 continue;
-            const double* from = block.data() + size * static_cast<std::size_t>(owned_position(
-                                                           d, me, wrapped(d, g, kind)));
+            const double* from =
+                block + size * static_cast<std::size_t>(owned_position(d, me, wrapped(d, g, kind)));
             std::vector<double>& to = sends[static_cast<std::size_t>(r)];
             to.insert(to.end(), from, from + size);
         }
     const std::vector<std::vector<double>> received = ranks.exchange(sends);
     std::vector<std::size_t> read(received.size(), 0);
-    for (int layer = 0; layer < block.nk(); ++layer) {
+    for (int layer = 0; layer < block_layers(d, me, kind); ++layer) {
         const int g = d.local_begin(me) + layer;
         if (owns(d, me, g, kind) || !within(d, me, g, depth))
             continue;
@@ -103,7 +107,7 @@ void exchange_halos(Array3<double>& block, const SlabDecomposition& d,
             throw std::runtime_error("exchange_halos: rank " + std::to_string(from) +
                                      " sent fewer layers than expected");
         std::copy_n(received[from].begin() + static_cast<std::ptrdiff_t>(read[from]), size,
-                    block.data() + size * static_cast<std::size_t>(layer));
+                    block + size * static_cast<std::size_t>(layer));
         read[from] += size;
     }
 }

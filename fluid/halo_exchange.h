@@ -5,6 +5,8 @@
 /// field from the owned layers (output). The layout is slab_decomposition.h's: a block of a
 /// cell-centred field has decomposition.local_layers(rank) z-layers, a field on z-faces one more.
 
+#include <cstddef>
+
 #include "fluid/array3.h"
 #include "fluid/rank_communicator.h"
 #include "fluid/slab_decomposition.h"
@@ -24,6 +26,11 @@ int block_layers(const SlabDecomposition& decomposition, int rank, LayerKind kin
 /// that reach reads; the viscous CG refreshes 2 of 5 every iteration).
 void exchange_halos(Array3<double>& block, const SlabDecomposition& decomposition,
                     const RankCommunicator& ranks, LayerKind kind, int depth = 0);
+/// exchange_halos() on a block stored elsewhere: block_layers() contiguous z-layers of
+/// `layer_size` values each from `block` (a component inside a longer vector).
+void exchange_halo_layers(double* block, std::size_t layer_size,
+                          const SlabDecomposition& decomposition, const RankCommunicator& ranks,
+                          LayerKind kind, int depth = 0);
 
 /// `rank`'s block of a field that is held whole (nz or nz + 1 z-layers): its layers, ghosts
 /// included, wrapped around a periodic z.

@@ -621,7 +621,6 @@ struct ViscositySolver::Workspace {
     SlabDecomposition decomposition;
     RankCommunicator ranks = RankCommunicator::self();
     std::vector<char> owned;  ///< distributed: 1 on the entries of [u | v | w] this rank owns
-    std::array<Array3<double>, 3> halo;  ///< distributed: scratch for the halo exchange
     OperatorKey key;  ///< what `op` and `diagonal` were built from (empty φ: nothing yet)
     std::vector<double> u_star, fixed, x, b, r, z, p, q, diagonal;
     /// multigrid: the component blocks and their V-cycles (built on first use after `op`).
@@ -743,12 +742,10 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         std::size_t offset = 0;
         for (int a = 0; a < 3; ++a) {
             const Array3<double>& faces = grid.velocity(a);
-            Array3<double>& h = ws.halo[static_cast<std::size_t>(a)];
-            h.resize(faces.ni(), faces.nj(), faces.nk());
-            std::copy_n(v.begin() + static_cast<std::ptrdiff_t>(offset), faces.size(), h.data());
-            exchange_halos(h, ws.decomposition, ws.ranks,
-                           a == 2 ? LayerKind::z_faces : LayerKind::cells, VISCOUS_HALO_DEPTH);
-            std::copy_n(h.data(), faces.size(), v.begin() + static_cast<std::ptrdiff_t>(offset));
+            exchange_halo_layers(
+                v.data() + offset, static_cast<std::size_t>(faces.ni()) * faces.nj(),
+                ws.decomposition, ws.ranks, a == 2 ? LayerKind::z_faces : LayerKind::cells,
+                VISCOUS_HALO_DEPTH);
             offset += faces.size();
         }
     };
