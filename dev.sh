@@ -30,6 +30,11 @@ SANITIZE_EXCLUDE+='|MovingWalls\.LidOverAClosedChannel|FluidSolver\.TaylorGreenV
 SANITIZE_EXCLUDE+='|FuzzRun.*/[1-6]$|RenderPath|FluidScenes\.TimeDtCapsTheFluidStep'
 SANITIZE_EXCLUDE+='|Resume\.(FluidRunKilled|GeometricFlowKilled|OneAndTwoThreads)'
 SANITIZE_EXCLUDE+='|DistributedRun\.(BubbleMerge|JetPinch)'
+# test_fluid_distributed_grid run as a single process (an MPI singleton) crashes LeakSanitizer's
+# tracer at exit ("Tracer caught signal 11") whenever TMPDIR is an existing folder, as run_ctest
+# makes it (Open MPI then keeps a session under it); the tests pass, the exit check dies. The same
+# tests run sanitized under mpirun (DistributedGrid.mpirun_2_ranks and _3_ranks), which pass.
+SANITIZE_EXCLUDE+='|RankCommunicator\.|HaloExchange\.|Distributed(Projection|Viscosity|FluidSolver)\.'
 # Any finding ends the program with exit code 86 (tests then fail); LeakSanitizer included.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-exitcode=86:detect_leaks=1:strict_string_checks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-exitcode=86:print_stacktrace=1}
