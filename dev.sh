@@ -34,7 +34,7 @@ SANITIZE_EXCLUDE+='|DistributedRun\.(BubbleMerge|JetPinch)'
 # tracer at exit ("Tracer caught signal 11") whenever TMPDIR is an existing folder, as run_ctest
 # makes it (Open MPI then keeps a session under it); the tests pass, the exit check dies. The same
 # tests run sanitized under mpirun (DistributedGrid.mpirun_2_ranks and _3_ranks), which pass.
-SANITIZE_EXCLUDE+='|RankCommunicator\.|HaloExchange\.|Distributed(Projection|Viscosity|FluidSolver)\.'
+SANITIZE_EXCLUDE+='|RankCommunicator\.|HaloExchange\.|DistributedProjection\.|DistributedViscosity\.|DistributedFluidSolver\.'
 # Any finding ends the program with exit code 86 (tests then fail); LeakSanitizer included.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-exitcode=86:detect_leaks=1:strict_string_checks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-exitcode=86:print_stacktrace=1}
