@@ -1,0 +1,485 @@
+#include "fluid/viscous_operator.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "fluid/surface_viscosity.h"
+
+namespace meniscus::fluid {
+
+namespace {
+
+/// Weight of a shear strain-rate term: 2 μ ε_ab² = ½ μ (∂_b u_a + ∂_a u_b)².
+constexpr double SHEAR_WEIGHT = 0.5;
+constexpr double HALF = 0.5;
+/// A no-slip wall mirrors the tangential velocity: the one-sided derivative doubles.
+constexpr double MIRROR_FACTOR = 2.0;
+/// The part of an outflow face's control volume inside the box.
+constexpr double OUTFLOW_VOLUME_FRACTION = 0.5;
+
+}  // namespace
+
+using Index3 = ViscousOperator::Index3;
+
+template <class Visit>
+void ViscousOperator::for_each_face(int a, Visit&& visit) const {
+    const Index3& dims = m_face_dims[a];
+    tbb::parallel_for(tbb::blocked_range<int>(0, dims[2]), [&](const tbb::blocked_range<int>& r) {
+        for (int k = r.begin(); k != r.end(); ++k) {
+            for (int j = 0; j < dims[1]; ++j) {
+                for (int i = 0; i < dims[0]; ++i) {
+                    const Index3 f = {i, j, k};
+                    if (!solvable(a, f)) {
+                        continue;
+                    }
+                    visit(f, face_flat(a, f));
+                }
+            }
+        }
+    });
+}
+
+template <typename Visit>
+void ViscousOperator::for_each_edge_cell(const Index3& e, int a, int b, Visit&& visit) const {
+    for (int da = -1; da <= 0; ++da) {
+        for (int db = -1; db <= 0; ++db) {
+            Index3 cell = e;
+            cell[a] += da;
+            cell[b] += db;
+            for (int axis : {a, b})  // around the seam's edge the last cells
+                if (cell[axis] < 0 && periodic(axis))
+                    cell[axis] += m_n[axis];
+            if (m_mu.contains(cell[0], cell[1], cell[2]))
+                visit(cell);
+        }
+    }
+}
+
+void ViscousOperator::build(const MacGrid& grid, const Array3<double>& phi,
+                            const PhaseOptions& phases, FluidMode mode,
+                            const BoundaryOptions& walls, double dt, double min_liquid_fraction,
+                            ViscosityWeights weights, const SurfaceViscosity* surface) {
+    m_n = {grid.nx(), grid.ny(), grid.nz()};
+    m_dx = grid.dx();
+    m_dt = dt;
+    m_surface = surface;
+    for (int a = 0; a < 3; ++a) {
+        for (int side = 0; side < 2; ++side)
+            m_open[a][side] = walls.at(a, side) == BoundaryType::outflow;
+        m_periodic[static_cast<std::size_t>(a)] = walls.periodic(a);
+    }
+    // The surface term's energy ½ Δt μ_s (S u)ᵀ L (S u), per cell volume as the rest.
+    m_surface_scale = surface ? dt * surface->viscosity / (m_dx * m_dx * m_dx) : 0.0;
+    std::size_t offset = 0;
+    for (int a = 0; a < 3; ++a) {
+        m_face_dims[a] = m_n;
+        ++m_face_dims[a][a];
+        m_offset[a] = offset;
+        offset += grid.velocity(a).size();
+        Index3 edge_dims = {m_n[0] + 1, m_n[1] + 1, m_n[2] + 1};
+        --edge_dims[a];  // edges parallel to axis a
+        m_edge_weight[a].resize(edge_dims[0], edge_dims[1], edge_dims[2], 0.0);
+        m_shear_stress[a].resize(edge_dims[0], edge_dims[1], edge_dims[2], 0.0);
+        m_normal_stress[a].resize(m_n[0], m_n[1], m_n[2], 0.0);
+    }
+    m_size = offset;
+    m_mu.resize(m_n[0], m_n[1], m_n[2]);
+    m_fraction_weights =
+        mode == FluidMode::free_surface || weights == ViscosityWeights::volume_fraction;
+    m_pointwise_edges = mode == FluidMode::two_phase && weights == ViscosityWeights::pointwise;
+    m_mu_gas = mode == FluidMode::two_phase ? phases.mu_gas : 0.0;
+    for (std::size_t c = 0; c < m_mu.size(); ++c) {
+        m_mu[c] = m_fraction_weights ? blended_mu(phases.mu_liquid, control_volume_fraction(phi[c]))
+                                     : (is_liquid(phi[c]) ? phases.mu_liquid : m_mu_gas);
+    }
+    set_edge_weights(walls, phi, phases);
+    set_faces(phi, phases, mode, min_liquid_fraction);
+}
+
+void ViscousOperator::gather(const MacGrid& grid, std::vector<double>& x) const {
+    x.resize(m_size);
+    for (int a = 0; a < 3; ++a) {
+        const std::vector<double>& faces = grid.velocity(a).storage();
+        std::copy(faces.begin(), faces.end(), x.begin() + m_offset[a]);
+    }
+}
+
+void ViscousOperator::scatter(const std::vector<double>& x, MacGrid& grid) const {
+    for (int a = 0; a < 3; ++a) {
+        std::vector<double>& faces = grid.velocity(a).storage();
+        std::copy(x.begin() + m_offset[a], x.begin() + m_offset[a] + faces.size(), faces.begin());
+    }
+}
+
+void ViscousOperator::stiffness(const std::vector<double>& x, std::vector<double>& y,
+                                const BoundaryOptions* moving) const {
+    y.resize(m_size);
+    normal_stresses(x);
+    shear_stresses(x, moving);
+    stress_divergence(y);
+    if (m_surface)
+        m_surface->add_stiffness(m_surface_scale, x, y);
+}
+
+void ViscousOperator::apply(const std::vector<double>& x, std::vector<double>& y) const {
+    stiffness(x, y);
+    for (std::size_t f = 0; f < m_size; ++f) {
+        y[f] = m_unknown[f] ? y[f] + m_density[f] * x[f] : 0.0;
+    }
+}
+
+void ViscousOperator::diagonal(std::vector<double>& d) const {
+    d.assign(m_size, 1.0);
+    const double inv_dx2 = 1.0 / (m_dx * m_dx);
+    for (int a = 0; a < 3; ++a) {
+        for_each_face(a, [&](const Index3& f, std::size_t flat) {
+            if (!m_unknown[flat]) {
+                return;
+            }
+            Index3 lo = f;
+            --lo[a];
+            // An outflow face has its cell on one side only.
+            if (f[a] == 0 && periodic(a))
+                lo[a] = m_n[a] - 1;  // the seam
+            const double mu_lo = lo[a] >= 0 ? m_mu(lo[0], lo[1], lo[2]) : 0.0;
+            const double mu_hi = f[a] < m_n[a] ? m_mu(f[0], f[1], f[2]) : 0.0;
+            double sum = m_density[flat] + 2.0 * m_dt * (mu_lo + mu_hi) * inv_dx2;
+            for (int b = 0; b < 3; ++b) {
+                if (b == a) {
+                    continue;
+                }
+                const Array3<double>& weight = m_edge_weight[3 - a - b];
+                Index3 above = f;
+                ++above[b];
+                const bool wrap = periodic(b);
+                const double c_below = (f[b] == 0 && !wrap ? MIRROR_FACTOR : 1.0);
+                const double c_above = (above[b] == m_n[b] && !wrap ? MIRROR_FACTOR : 1.0);
+                if (above[b] == m_n[b] && wrap)
+                    above[b] = 0;  // the seam's edge
+                sum += 2.0 * m_dt * inv_dx2 *
+                       (weight(f[0], f[1], f[2]) * c_below * c_below +
+                        weight(above[0], above[1], above[2]) * c_above * c_above);
+            }
+            d[flat] = sum;
+        });
+    }
+    if (m_surface) {
+        std::vector<double> surface(m_size, 0.0);
+        m_surface->add_diagonal_bound(m_surface_scale, surface);
+        for (std::size_t f = 0; f < m_size; ++f)
+            if (m_unknown[f])
+                d[f] += surface[f];
+    }
+}
+
+void ViscousOperator::component_blocks(const std::vector<double>& d,
+                                       std::array<PoissonMatrix, 3>& blocks) const {
+    const double scale = 2.0 * m_dt / (m_dx * m_dx);
+    for (int a = 0; a < 3; ++a) {
+        const Index3& dims = m_face_dims[a];
+        PoissonMatrix& m = blocks[static_cast<std::size_t>(a)];
+        m.resize(dims[0], dims[1], dims[2]);
+        Array3<double>* off[3] = {&m.off_x, &m.off_y, &m.off_z};
+        for_each_face(a, [&](const Index3& f, std::size_t flat) {
+            if (!m_unknown[flat])
+                return;
+            m.diag(f[0], f[1], f[2]) = d[flat];
+            for (int b = 0; b < 3; ++b) {
+                Index3 next = f;
+                ++next[b];
+                if (next[b] >= dims[b] || !m_unknown[face_flat(a, next)])
+                    continue;
+                // Along a the two faces share cell f; across b the edge between them.
+                const double weight = b == a ? m_mu(f[0], f[1], f[2])
+                                             : m_edge_weight[3 - a - b](next[0], next[1], next[2]);
+                (*off[b])(f[0], f[1], f[2]) = -scale * weight;
+            }
+        });
+    }
+}
+
+bool ViscousOperator::solvable(int a, const Index3& f) const {
+    if (f[a] == 0)  // across a periodic axis the face at 0 is the seam; the one at n its copy
+        return m_open[a][0] || periodic(a);
+    return f[a] != m_n[a] || m_open[a][1];
+}
+
+std::size_t ViscousOperator::face_flat(int a, const Index3& f) const {
+    const Index3& d = m_face_dims[a];
+    return m_offset[a] + static_cast<std::size_t>(f[0]) +
+           static_cast<std::size_t>(d[0]) *
+               (static_cast<std::size_t>(f[1]) + static_cast<std::size_t>(d[1]) * f[2]);
+}
+
+double ViscousOperator::control_volume_fraction(double phi) const {
+    return std::clamp(HALF - phi / m_dx, 0.0, 1.0);
+}
+
+double ViscousOperator::blended_mu(double mu_liquid, double fraction) const {
+    return m_mu_gas + (mu_liquid - m_mu_gas) * fraction;
+}
+
+void ViscousOperator::set_edge_weights(const BoundaryOptions& walls, const Array3<double>& phi,
+                                       const PhaseOptions& phases) {
+    for (int c = 0; c < 3; ++c) {
+        const int a = (c + 1) % 3;
+        const int b = (c + 2) % 3;
+        Array3<double>& weight = m_edge_weight[c];
+        for (int k = 0; k < weight.nk(); ++k) {
+            for (int j = 0; j < weight.nj(); ++j) {
+                for (int i = 0; i < weight.ni(); ++i) {
+                    const Index3 e = {i, j, k};
+                    double fraction = 1.0;
+                    bool free_slip = false;
+                    bool copy = false;  // the seam's edge at n, a copy of the one at 0
+                    for (int axis : {a, b}) {
+                        if (periodic(axis)) {
+                            copy |= e[axis] == m_n[axis];
+                            continue;
+                        }
+                        if (e[axis] == 0 || e[axis] == m_n[axis]) {
+                            fraction *= HALF;  // half the edge's dual cell is outside
+                            const int side = e[axis] == 0 ? 0 : 1;
+                            free_slip |= walls.at(axis, side) == BoundaryType::free_slip;
+                        }
+                    }
+                    if (free_slip || copy) {
+                        continue;  // zero shear stress on a free-slip wall
+                    }
+                    if (m_fraction_weights || m_pointwise_edges) {
+                        // Batty & Bridson 2008: the shear term weighted by the liquid
+                        // fraction of the edge's control volume (φ at the edge: the mean of
+                        // its cells), so a traction-free surface sits where φ = 0, not on
+                        // the cell faces next to the void. Pointwise: the μ of the phase
+                        // at the edge's midpoint, by the sign of the same φ.
+                        double phi_sum = 0.0;
+                        int count = 0;
+                        for_each_edge_cell(e, a, b, [&](const Index3& cell) {
+                            phi_sum += phi(cell[0], cell[1], cell[2]);
+                            ++count;
+                        });
+                        const double phi_edge = phi_sum / count;
+                        weight(i, j, k) =
+                            SHEAR_WEIGHT * fraction *
+                            (m_pointwise_edges
+                                 ? (is_liquid(phi_edge) ? phases.mu_liquid : m_mu_gas)
+                                 : blended_mu(phases.mu_liquid, control_volume_fraction(phi_edge)));
+                        continue;
+                    }
+                    // Harmonic mean of the (up to 4) cells around the edge: exact for the
+                    // shear stress across a layer interface through the edge; 0 next to a
+                    // cell with μ = 0.
+                    double inverse_sum = 0.0;
+                    int count = 0;
+                    bool inviscid = false;
+                    for_each_edge_cell(e, a, b, [&](const Index3& cell) {
+                        const double mu = m_mu(cell[0], cell[1], cell[2]);
+                        inviscid |= mu == 0.0;
+                        inverse_sum += inviscid ? 0.0 : 1.0 / mu;
+                        ++count;
+                    });
+                    if (!inviscid) {
+                        weight(i, j, k) = SHEAR_WEIGHT * fraction * count / inverse_sum;
+                    }
+                }
+            }
+        }
+    }
+}
+
+void ViscousOperator::set_faces(const Array3<double>& phi, const PhaseOptions& phases,
+                                FluidMode mode, double min_liquid_fraction) {
+    m_unknown.assign(m_size, 0);
+    m_density.assign(m_size, 0.0);
+    for (int a = 0; a < 3; ++a) {
+        for_each_face(a, [&](const Index3& f, std::size_t flat) {
+            Index3 lo = f;
+            --lo[a];
+            // An outflow face takes the phase of its one cell.
+            Index3 hi = f;
+            const bool seam = periodic(a) && f[a] == 0;
+            if (seam)
+                lo[a] = m_n[a] - 1;
+            else if (f[a] == 0)
+                lo = hi;
+            if (f[a] == m_n[a])
+                hi = lo;
+            const double phi_lo = phi(lo[0], lo[1], lo[2]);
+            const double phi_hi = phi(hi[0], hi[1], hi[2]);
+            if (mode == FluidMode::free_surface && !is_liquid(phi_lo) && !is_liquid(phi_hi)) {
+                return;
+            }
+            m_unknown[flat] = 1;
+            const double theta = liquid_fraction(phi_lo, phi_hi);
+            m_density[flat] = mode == FluidMode::free_surface
+                                  ? phases.rho_liquid * std::max(theta, min_liquid_fraction)
+                                  : face_density(theta, phases, mode);
+            // An outflow face's control volume is the half cell inside the box, like the
+            // half dual cells of the shear terms on it and the pressure's distance Δx/2.
+            if ((f[a] == 0 && !seam) || f[a] == m_n[a])
+                m_density[flat] *= OUTFLOW_VOLUME_FRACTION;
+        });
+    }
+}
+
+void ViscousOperator::normal_stresses(const std::vector<double>& x) const {
+    const double scale = 2.0 * m_dt / m_dx;
+    for (int a = 0; a < 3; ++a) {
+        Array3<double>& sigma = m_normal_stress[a];
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, m_n[2]), [&](const tbb::blocked_range<int>& r) {
+                for (int k = r.begin(); k != r.end(); ++k) {
+                    for (int j = 0; j < m_n[1]; ++j) {
+                        for (int i = 0; i < m_n[0]; ++i) {
+                            const Index3 c = {i, j, k};
+                            Index3 hi = c;
+                            ++hi[a];
+                            if (hi[a] == m_n[a] && periodic(a))
+                                hi[a] = 0;  // the face at n is the seam's copy
+                            sigma(i, j, k) =
+                                scale * m_mu(i, j, k) * (x[face_flat(a, hi)] - x[face_flat(a, c)]);
+                        }
+                    }
+                }
+            });
+    }
+}
+
+std::size_t ViscousOperator::face_stride(int a, int axis) const {
+    const Index3& d = m_face_dims[a];
+    return axis == 0   ? 1
+           : axis == 1 ? static_cast<std::size_t>(d[0])
+                       : static_cast<std::size_t>(d[0]) * d[1];
+}
+
+void ViscousOperator::shear_stresses(const std::vector<double>& x,
+                                     const BoundaryOptions* moving) const {
+    for (int c = 0; c < 3; ++c) {
+        const int a = (c + 1) % 3;
+        const int b = (c + 2) % 3;
+        // The walls' velocity components along the derivative's numerator: x_a at the b
+        // walls, x_b at the a walls.
+        const auto wall = [&](int axis, int side, int component) {
+            return moving ? moving->face(axis, side).velocity[component] : 0.0;
+        };
+        const double a_lo = wall(b, 0, a), a_hi = wall(b, 1, a);
+        const double b_lo = wall(a, 0, b), b_hi = wall(a, 1, b);
+        const Array3<double>& weight = m_edge_weight[c];
+        Array3<double>& tau = m_shear_stress[c];
+        const std::size_t step_a = face_stride(a, b);  // x_a along b
+        const std::size_t step_b = face_stride(b, a);  // x_b along a
+        const int n_a = m_n[a];
+        const int n_b = m_n[b];
+        const bool wrap_a = periodic(a), wrap_b = periodic(b);
+        // Across a periodic seam (an edge at 0) the derivative reaches back to the last face.
+        const std::size_t seam_a = static_cast<std::size_t>(n_b - 1) * step_a;
+        const std::size_t seam_b = static_cast<std::size_t>(n_a - 1) * step_b;
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, weight.nk()), [&](const tbb::blocked_range<int>& r) {
+                for (int k = r.begin(); k != r.end(); ++k) {
+                    for (int j = 0; j < weight.nj(); ++j) {
+                        // Face indices of (0, j, k) in arrays a and b (an index one past
+                        // an array's end on axis b or a is only ever used minus its step).
+                        const std::size_t row_a = face_flat(a, {0, j, k});
+                        const std::size_t row_b = face_flat(b, {0, j, k});
+                        const std::size_t edge_row = weight.index(0, j, k);
+                        for (int i = 0; i < weight.ni(); ++i) {
+                            const double w = weight[edge_row + i];
+                            if (w == 0.0) {
+                                tau[edge_row + i] = 0.0;
+                                continue;
+                            }
+                            const Index3 e = {i, j, k};
+                            const std::size_t fa = row_a + i;
+                            const std::size_t fb = row_b + i;
+                            const double d_ab =
+                                e[b] == 0 && wrap_b ? (x[fa] - x[fa + seam_a]) / m_dx
+                                : e[b] == 0         ? MIRROR_FACTOR * (x[fa] - a_lo) / m_dx
+                                : e[b] == n_b ? -MIRROR_FACTOR * (x[fa - step_a] - a_hi) / m_dx
+                                              : (x[fa] - x[fa - step_a]) / m_dx;
+                            const double d_ba =
+                                e[a] == 0 && wrap_a ? (x[fb] - x[fb + seam_b]) / m_dx
+                                : e[a] == 0         ? MIRROR_FACTOR * (x[fb] - b_lo) / m_dx
+                                : e[a] == n_a ? -MIRROR_FACTOR * (x[fb - step_b] - b_hi) / m_dx
+                                              : (x[fb] - x[fb - step_b]) / m_dx;
+                            tau[edge_row + i] = 2.0 * m_dt * w * (d_ab + d_ba);
+                        }
+                    }
+                }
+            });
+    }
+}
+
+void ViscousOperator::stress_divergence(std::vector<double>& y) const {
+    const double inv_dx = 1.0 / m_dx;
+    for (int a = 0; a < 3; ++a) {
+        const Array3<double>& sigma = m_normal_stress[a];
+        const Index3& dims = m_face_dims[a];
+        const std::size_t cell_step = a == 0   ? 1
+                                      : a == 1 ? static_cast<std::size_t>(m_n[0])
+                                               : static_cast<std::size_t>(m_n[0]) * m_n[1];
+        // The two shear arrays this component meets, in the order b = 0, 1, 2 (b ≠ a).
+        std::array<int, 2> other{};
+        std::array<std::size_t, 2> edge_step{};
+        int count = 0;
+        for (int b = 0; b < 3; ++b) {
+            if (b == a)
+                continue;
+            const Array3<double>& tau = m_shear_stress[3 - a - b];
+            other[count] = b;
+            edge_step[count] = b == 0   ? 1
+                               : b == 1 ? static_cast<std::size_t>(tau.ni())
+                                        : static_cast<std::size_t>(tau.ni()) * tau.nj();
+            ++count;
+        }
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, dims[2]), [&](const tbb::blocked_range<int>& r) {
+                for (int k = r.begin(); k != r.end(); ++k) {
+                    for (int j = 0; j < dims[1]; ++j) {
+                        const std::size_t face_row = face_flat(a, {0, j, k});
+                        for (int i = 0; i < dims[0]; ++i) {
+                            const Index3 f = {i, j, k};
+                            if (!solvable(a, f))
+                                continue;
+                            // Cell f lies above the face, cell f − e_a below it (an outflow
+                            // face has one of them). The flat index of f is formed without
+                            // the array's bounds: on the max face only cell − step is read.
+                            const std::size_t cell = static_cast<std::size_t>(i) +
+                                                     static_cast<std::size_t>(m_n[0]) *
+                                                         (static_cast<std::size_t>(j) +
+                                                          static_cast<std::size_t>(m_n[1]) * k);
+                            double sum = 0.0;
+                            if (f[a] > 0)
+                                sum += sigma[cell - cell_step] * inv_dx;
+                            else if (periodic(a))  // the seam: the last cell below it
+                                sum += sigma[cell + (m_n[a] - 1) * cell_step] * inv_dx;
+                            if (f[a] < m_n[a])
+                                sum -= sigma[cell] * inv_dx;
+                            for (int t = 0; t < 2; ++t) {
+                                const int b = other[t];
+                                const Array3<double>& tau = m_shear_stress[3 - a - b];
+                                const std::size_t below = tau.index(i, j, k);
+                                // Across a periodic b the edge above the last face is the
+                                // seam's, at 0; no wall there to mirror.
+                                const bool wrap = periodic(b);
+                                const bool last = f[b] + 1 == m_n[b];
+                                const std::size_t above = wrap && last ? below - f[b] * edge_step[t]
+                                                                       : below + edge_step[t];
+                                const double c_below =
+                                    (f[b] == 0 && !wrap ? MIRROR_FACTOR : 1.0) * inv_dx;
+                                const double c_above =
+                                    -(last && !wrap ? MIRROR_FACTOR : 1.0) * inv_dx;
+                                sum += tau[below] * c_below + tau[above] * c_above;
+                            }
+                            y[face_row + i] = sum;
+                        }
+                    }
+                }
+            });
+    }
+}
+
+}  // namespace meniscus::fluid
