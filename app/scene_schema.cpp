@@ -158,9 +158,11 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
                "`pointwise` (the phase at each cell centre and edge midpoint)");
     enum_field(v, "viscosity_preconditioner", o.viscosity.preconditioner,
                {{"multigrid", fluid::ViscousPreconditioner::multigrid},
-                {"jacobi", fluid::ViscousPreconditioner::jacobi}},
-               "preconditioner of the viscous CG: a V-cycle per velocity component's block, or "
-               "the diagonal");
+                {"jacobi", fluid::ViscousPreconditioner::jacobi},
+                {"hypre_pfmg", fluid::ViscousPreconditioner::hypre_pfmg}},
+               "preconditioner of the viscous CG: a V-cycle per velocity component's block "
+               "(`multigrid` our own, `hypre_pfmg` hypre's PFMG, which also runs on several "
+               "ranks), or the diagonal");
     v.integer("viscosity_max_iterations", o.viscosity.iteration.max_iterations,
               Range::between(1, 100000), "", "CG iterations before a viscosity solve gives up");
     v.section("viscous_pressure", "how the viscous and pressure solves are coupled in a step",

@@ -8,7 +8,12 @@
 // BM_PressureSolve/N: the first step's pressure system (the projection of the body force and
 // the σκ jump, assembled on each rank's block) solved by hypre's PFMG-preconditioned PCG over the
 // ranks to a relative residual of 1e-8 (fluid/distributed_projection.h); one process also times
-// our multigrid PCG on the same system. BM_CoupledStep/N: Simulation::step, one untimed step
+// our multigrid PCG on the same system. BM_ViscousSolve/N/pc/mu: the implicit viscosity solve of
+// the flow after one coupled step (Δt = 1e-4 s), with the liquid's μ = mu mPa·s (1: water,
+// νΔt/Δx² ≈ 0.016 at 128³; 1000: a glycerol-like liquid, ≈ 16), to a relative residual of 1e-8,
+// its CG preconditioned by pc = 0 the diagonal, 1 our multigrid V-cycles (one process only),
+// 2 hypre's PFMG V-cycles (fluid/viscosity.h); the time includes building the operator and the
+// preconditioner, as every step does. BM_CoupledStep/N: Simulation::step, one untimed step
 // first, then MENISCUS_BENCH_CUBE_STEPS timed steps (default 3).
 //
 // Every rank runs every benchmark a fixed number of times (the collective calls must match);
@@ -38,6 +43,7 @@
 #include "fluid/distributed_projection.h"
 #include "fluid/forces.h"
 #include "fluid/rank_communicator.h"
+#include "fluid/viscosity.h"
 
 namespace {
 
@@ -136,6 +142,59 @@ void BM_PressureSolve(benchmark::State& state) {
     state.SetLabel(own ? "multigrid PCG (one process)" : "hypre PFMG-PCG");
 }
 
+void BM_ViscousSolve(benchmark::State& state) {
+    const int cells = static_cast<int>(state.range(0));
+    const auto kind = static_cast<fluid::ViscousPreconditioner>(state.range(1));
+    const double mu_liquid = 1e-3 * static_cast<double>(state.range(2));
+    if (kind == fluid::ViscousPreconditioner::multigrid && g_ranks.size() > 1) {
+        state.SkipWithError("our multigrid V-cycles run on one process only");
+        for (auto _ : state)
+            state.SetIterationTime(0.0);
+        return;
+    }
+    const std::unique_ptr<coupling::Simulation> sim = make_simulation(cells);
+    const double dt = 1e-4;
+    sim->step(dt);  // a velocity field to diffuse: the bubbles' first rise and the σκ jump
+    const fluid::FluidSolver& solver = sim->fluid();
+    const coupling::RasterizeResult raster =
+        coupling::rasterize_mesh(sim->tracker().mesh(), solver.grid());
+    fluid::InterfaceInput interface(solver.grid());
+    interface.phi = raster.phi;
+    fluid::PhaseOptions phases = solver.options().phases;
+    phases.mu_liquid = mu_liquid;
+    fluid::ViscosityOptions options = solver.options().viscosity;
+    options.preconditioner = kind;
+    options.iteration.tolerance = 1e-8;
+    options.iteration.max_iterations = 100000;
+    const fluid::CommunicationCounts before = fluid::communication_counts();
+    long long iterations = 0, steps = 0;
+    for (auto _ : state) {
+        fluid::MacGrid grid = solver.grid();
+        fluid::ViscositySolver viscosity;
+        if (g_ranks.size() > 1)
+            viscosity.distribute(solver.blocks().decomposition(), g_ranks);
+        g_ranks.barrier();
+        const auto start = Clock::now();
+        const fluid::SolveResult r = viscosity.solve(grid, interface, phases, solver.options().mode,
+                                                     solver.grid_boundaries(), dt, options);
+        const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+        state.SetIterationTime(g_ranks.max(seconds));
+        if (!r.converged)
+            state.SkipWithError("the viscous solve did not converge");
+        iterations += r.iterations;
+        ++steps;
+    }
+    const double whole = static_cast<double>(cells) * cells * cells;
+    const fluid::SlabDecomposition& d = solver.blocks().decomposition();
+    set_common_counters(state, whole, static_cast<double>(steps), before,
+                        solver.grid().nx() * solver.grid().ny() *
+                            (d.owned_end(g_ranks.rank()) - d.owned_begin(g_ranks.rank())));
+    state.counters["cg_its"] = static_cast<double>(iterations) / static_cast<double>(steps);
+    state.SetLabel(kind == fluid::ViscousPreconditioner::jacobi      ? "Jacobi CG"
+                   : kind == fluid::ViscousPreconditioner::multigrid ? "multigrid-CG (one process)"
+                                                                     : "hypre PFMG-CG");
+}
+
 void BM_CoupledStep(benchmark::State& state) {
     const int cells = static_cast<int>(state.range(0));
     const std::unique_ptr<coupling::Simulation> sim = make_simulation(cells);
@@ -180,6 +239,12 @@ const int CUBE_STEPS = env_int("MENISCUS_BENCH_CUBE_STEPS", 3);
 BENCHMARK(BM_PressureSolve)
     ->ArgsProduct({{128, 192}, {0, 1}})
     ->ArgNames({"cells", "own"})
+    ->Iterations(2)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ViscousSolve)
+    ->ArgsProduct({{128}, {0, 1, 2}, {1, 1000}})
+    ->ArgNames({"cells", "pc", "mu"})
     ->Iterations(2)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);

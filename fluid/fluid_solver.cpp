@@ -135,9 +135,10 @@ FluidSolver::FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3
                         (side == 0 ? "_min" : "_max") +
                         ": inflow faces on x or y are not available on several ranks (their "
                         "profile spans z, which the ranks split); put the inflow on a z face");
-        if (m_options.viscosity.preconditioner != ViscousPreconditioner::jacobi)
+        if (m_options.viscosity.preconditioner == ViscousPreconditioner::multigrid)
             throw std::invalid_argument(
-                "viscosity/preconditioner: only jacobi is available on several ranks");
+                "viscosity/viscosity_preconditioner: multigrid is not available on several ranks "
+                "(jacobi or hypre_pfmg are)");
         m_viscosity.distribute(decomposition, ranks);
     }
     m_grid.set_periodic(

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "fluid/hypre_pressure.h"
 #include "fluid/multigrid.h"
 #include "fluid/poisson_matrix.h"
 #include "fluid/viscous_operator.h"
@@ -28,7 +29,8 @@ void ViscosityOptions::validate() const {
         weights != ViscosityWeights::pointwise)
         throw std::invalid_argument("ViscosityOptions.weights: unknown weighting");
     if (preconditioner != ViscousPreconditioner::jacobi &&
-        preconditioner != ViscousPreconditioner::multigrid)
+        preconditioner != ViscousPreconditioner::multigrid &&
+        preconditioner != ViscousPreconditioner::hypre_pfmg)
         throw std::invalid_argument("ViscosityOptions.preconditioner: unknown preconditioner");
     multigrid.validate();
 }
@@ -82,9 +84,15 @@ struct ViscositySolver::Workspace {
     std::vector<char> owned;  ///< distributed: 1 on the entries of [u | v | w] this rank owns
     OperatorKey key;          ///< what `op` and `diagonal` were built from (empty φ: nothing yet)
     std::vector<double> u_star, fixed, x, b, r, z, p, q, diagonal;
-    /// multigrid: the component blocks and their V-cycles (built on first use after `op`).
+    /// multigrid, hypre_pfmg: the component blocks and their V-cycles (built on first use
+    /// after `op`, of the kind `cycles_kind`). Distributed, the block of w stops below its top
+    /// face layer (`cropped`), so that it has the decomposition's z-layers as hypre needs.
     std::array<PoissonMatrix, 3> blocks;
-    std::array<std::unique_ptr<MultigridPreconditioner>, 3> cycles;
+    std::array<std::unique_ptr<Preconditioner>, 3> cycles;
+    ViscousPreconditioner cycles_kind = ViscousPreconditioner::jacobi;
+    bool cropped = false;
+
+    void build_cycles(const ViscousOperator& op, bool distributed, const ViscosityOptions& options);
     std::array<std::vector<double>, 3> block_r, block_z;
 };
 
@@ -105,6 +113,49 @@ void ViscositySolver::distribute(const SlabDecomposition& decomposition,
     m_workspace->decomposition = decomposition;
     m_workspace->ranks = ranks;
     m_workspace->owned.clear();
+}
+
+/// The per-component preconditioners of `options.preconditioner` (multigrid or hypre_pfmg) on
+/// the blocks of `op` (ViscousOperator::component_blocks with the workspace's diagonal).
+/// hypre: one HyprePressureSolver (a 7-point Struct system with its PFMG V-cycle) per component;
+/// distributed, collective, on each rank's block, w's cropped to the decomposition's layers.
+void ViscositySolver::Workspace::build_cycles(const ViscousOperator& op, bool distributed,
+                                              const ViscosityOptions& options) {
+    Workspace& ws = *this;
+    op.component_blocks(ws.diagonal, ws.blocks);
+    ws.cropped = false;
+    const int rank = ws.ranks.rank();
+    for (std::size_t a = 0; a < 3; ++a) {
+        ws.cycles[a].reset();
+        if (options.preconditioner == ViscousPreconditioner::multigrid) {
+            ws.cycles[a] =
+                std::make_unique<MultigridPreconditioner>(ws.blocks[a], options.multigrid);
+            continue;
+        }
+        if (!distributed) {
+            ws.cycles[a] = std::make_unique<HyprePressureSolver>(ws.blocks[a], false);
+            continue;
+        }
+        PoissonMatrix& block = ws.blocks[a];
+        const int layers = ws.decomposition.local_layers(rank);
+        if (block.nk() == layers + 1) {  // w: its faces' layers, one more than the cells'
+            PoissonMatrix cropped;
+            cropped.resize(block.ni(), block.nj(), layers);
+            for (int k = 0; k < layers; ++k)
+                for (int j = 0; j < block.nj(); ++j)
+                    for (int i = 0; i < block.ni(); ++i) {
+                        cropped.diag(i, j, k) = block.diag(i, j, k);
+                        cropped.off_x(i, j, k) = block.off_x(i, j, k);
+                        cropped.off_y(i, j, k) = block.off_y(i, j, k);
+                        cropped.off_z(i, j, k) = k + 1 < layers ? block.off_z(i, j, k) : 0.0;
+                    }
+            block = std::move(cropped);
+            ws.cropped = true;
+        }
+        ws.cycles[a] =
+            std::make_unique<HyprePressureSolver>(block, false, ws.decomposition, ws.ranks);
+    }
+    ws.cycles_kind = options.preconditioner;
 }
 
 SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interface,
@@ -134,8 +185,13 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     ViscousOperator& op = ws.op;
     OperatorKey key(grid, viscous_phases, mode, walls, dt, min_liquid_fraction, options.weights);
     key.surface = surface;
-    const bool reuse =
+    bool reuse =
         !ws.key.phi.empty() && ws.key.same_settings(key) && ws.key.phi == interface.phi.storage();
+    // Distributed, every rank rebuilds when one does: the hypre V-cycles are built collectively
+    // (a rank whose block's φ had not changed kept its operator while the others waited in
+    // hypre's set-up: a deadlock, found by `mpirun -n 2 meniscus run` of bubble_merge).
+    if (ws.decomposition.distributed())
+        reuse = ws.ranks.all(reuse);
     if (!reuse) {
         ws.key.phi.clear();  // nothing valid until the build is complete
         ws.diagonal.clear();
@@ -162,9 +218,10 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
             throw std::invalid_argument(
                 "ViscositySolver: semi-implicit surface tension is not available on several "
                 "ranks yet");
-        if (options.preconditioner != ViscousPreconditioner::jacobi)
+        if (options.preconditioner == ViscousPreconditioner::multigrid)
             throw std::invalid_argument(
-                "ViscosityOptions.preconditioner: only jacobi is available on several ranks");
+                "ViscosityOptions.preconditioner: multigrid is not available on several ranks "
+                "(jacobi or hypre_pfmg are)");
         if (ws.owned.size() != n) {
             ws.owned.assign(n, 0);
             const int rank = ws.ranks.rank();
@@ -236,29 +293,30 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         if (ws.diagonal.empty())
             op.diagonal(ws.diagonal);
         const std::vector<double>& diagonal = ws.diagonal;
-        const bool multigrid = options.preconditioner == ViscousPreconditioner::multigrid;
-        if (multigrid && !ws.cycles[0]) {
-            op.component_blocks(diagonal, ws.blocks);
-            for (std::size_t a = 0; a < 3; ++a)
-                ws.cycles[a] =
-                    std::make_unique<MultigridPreconditioner>(ws.blocks[a], options.multigrid);
-        }
+        const ViscousPreconditioner kind = options.preconditioner;
+        if (kind != ViscousPreconditioner::jacobi && (!ws.cycles[0] || ws.cycles_kind != kind))
+            ws.build_cycles(op, distributed, options);
         // z = M⁻¹ r: Jacobi, or a V-cycle on each component's block (r is zero on fixed faces,
-        // and so is z).
+        // and so is z). The layer of w's faces left out of a cropped block (the top face of the
+        // last rank's block, solved for only below an outflow; a ghost layer elsewhere) takes
+        // the diagonal.
         const auto precondition = [&]() {
-            if (!multigrid) {
+            if (kind == ViscousPreconditioner::jacobi) {
                 for (std::size_t f = 0; f < n; ++f)
                     z[f] = r[f] / diagonal[f];
                 return;
             }
             std::size_t offset = 0;
             for (std::size_t a = 0; a < 3; ++a) {
-                const std::size_t size = ws.blocks[a].size();
+                const std::size_t size = grid.velocity(static_cast<int>(a)).size();
+                const std::size_t in_block = ws.blocks[a].size();
                 ws.block_r[a].assign(r.begin() + static_cast<std::ptrdiff_t>(offset),
-                                     r.begin() + static_cast<std::ptrdiff_t>(offset + size));
+                                     r.begin() + static_cast<std::ptrdiff_t>(offset + in_block));
                 ws.cycles[a]->apply(ws.block_r[a], ws.block_z[a]);
                 std::copy(ws.block_z[a].begin(), ws.block_z[a].end(),
                           z.begin() + static_cast<std::ptrdiff_t>(offset));
+                for (std::size_t f = offset + in_block; f < offset + size; ++f)
+                    z[f] = r[f] / diagonal[f];
                 offset += size;
             }
         };

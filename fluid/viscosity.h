@@ -63,7 +63,7 @@ enum class ViscosityWeights {
 
 /// Preconditioner of the viscous conjugate gradients.
 enum class ViscousPreconditioner {
-    jacobi,    ///< the operator's diagonal
+    jacobi,  ///< the operator's diagonal
     /// one multigrid V-cycle (multigrid.h) on each velocity component's own block of the
     /// operator (its couplings to the other components left out). Pays where the viscous
     /// diffusion number νΔt/Δx² is large, since an iteration costs about 3.5 Jacobi ones: a
@@ -71,7 +71,14 @@ enum class ViscousPreconditioner {
     /// takes 187 instead of 988 iterations per step, 1.4× less CPU in the viscous solves (24³:
     /// 138 against 660, the same CPU); an air bubble in water (νΔt/Δx² ≈ 0.1) 12.5 instead of
     /// 17.2 and 2.3× the CPU. Not the default for that reason.
-    multigrid
+    multigrid,
+    /// one hypre PFMG V-cycle (hypre_pressure.h: a HYPRE_StructMatrix, symmetric red–black
+    /// Gauss–Seidel, Galerkin coarsening) on each velocity component's block, as `multigrid`
+    /// but through hypre's Struct interface; the CG around it stays ours, since the whole
+    /// operator couples the three components through the shear terms, which hypre's Struct
+    /// interface (one variable per grid) cannot hold. The one preconditioner besides jacobi that
+    /// runs on several ranks (collective, on each rank's block).
+    hypre_pfmg
 };
 
 /// Options of the implicit viscosity step.
@@ -109,9 +116,9 @@ public:
     /// Makes every later solve() collective over `ranks`: the grid it is given is then this
     /// rank's block of a grid split by `decomposition` (grid_block.h; at least 2 ghost layers,
     /// current before the call, filled again after it) and the conjugate gradients run over the
-    /// whole grid, each rank owning its slab's faces (Jacobi preconditioner only, no surface
-    /// viscosity). One rank: solve() as without. Throws std::invalid_argument when the sizes do
-    /// not fit.
+    /// whole grid, each rank owning its slab's faces (jacobi or hypre_pfmg preconditioner, no
+    /// surface viscosity). One rank: solve() as without. Throws std::invalid_argument when the
+    /// sizes do not fit.
     void distribute(const SlabDecomposition& decomposition, const RankCommunicator& ranks);
 
     /// See apply_viscosity().

@@ -179,6 +179,17 @@ TEST(DistributedRun, BubbleMergeMergesAtTheSameFrame) {
     expect_same_run("bubble_merge", scene, 3, 1);
 }
 
+TEST(DistributedRun, BubbleMergeWithTheViscousSolveOnHypre) {
+    // The viscous CG preconditioned by hypre's PFMG on every rank. Before the ranks agreed on
+    // rebuilding the viscous operator, this run hung in its second step: the rank whose block's
+    // φ had not changed skipped hypre's collective set-up that the other rank waited in.
+    Json scene = with_hypre(shipped_scene("bubble_merge"));
+    scene["fluid"]["viscosity_preconditioner"] = "hypre_pfmg";
+    scene["time"] = {{"end", 0.004}, {"frames", 4}};
+    scene["output"] = {{"ply", true}, {"vdb", true}};
+    expect_same_run("bubble_merge_viscous_hypre", scene, 2, 2);
+}
+
 TEST(DistributedRun, JetPinchPinchesAtTheSameFrame) {
     // The shortened jet of tests/coupling/test_scenes_physics.cpp (JetPinchQuick): one
     // wavelength, periodic along x (the grid is split along z, across the column), 27 cells per
@@ -207,6 +218,13 @@ TEST(DistributedRun, RefusesWhatIsNotDistributedYet) {
     const ChildResult nozzle = run(shipped_scene("jet_nozzle"), dir / "nozzle", 2);
     EXPECT_FALSE(nozzle.exited && nozzle.exit_code == 0) << nozzle.output;
     EXPECT_NE(nozzle.output.find("several MPI ranks"), std::string::npos) << nozzle.output;
+    Json own_cycles = shipped_scene("static_drop");
+    own_cycles["fluid"]["viscosity_preconditioner"] = "multigrid";
+    const ChildResult m = run(own_cycles, dir / "multigrid", 2);
+    EXPECT_FALSE(m.exited && m.exit_code == 0) << m.output;
+    EXPECT_NE(m.output.find("viscosity_preconditioner: multigrid is not available on several"),
+              std::string::npos)
+        << m.output;
     fs::remove_all(dir);
 }
 
