@@ -140,7 +140,7 @@ void BM_PressureSolve(benchmark::State& state, PressureSolver solver, int max_it
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         state.counters["levels"] = setup.levels();
     } else if (solver == PressureSolver::hypre_pfmg_pcg) {
-        const meniscus::fluid::HyprePressureSolver setup(system.matrix, system.singular);
+        const meniscus::fluid::HypreStructSolver setup(system.matrix, system.singular);
         setup_seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }

@@ -1,5 +1,5 @@
 # hypre (Debian libhypre-dev) and the MPI it is built against (Debian libopenmpi-dev): the
-# pressure Poisson solve through hypre's structured-grid interface (fluid/hypre_pressure.cpp).
+# pressure Poisson solve through hypre's structured-grid interface (fluid/hypre_struct_solver.cpp).
 # Both are linked PRIVATELY into meniscus_fluid: no MPI or hypre header appears in a public header.
 
 # FindMPI's C component needs the C language (the project is otherwise C++ only): hypre is a C

@@ -2,9 +2,9 @@
 /// \file The ghost-fluid pressure projection (pressure.h) of a grid split over ranks (issue 40):
 /// each rank assembles the system on its block (grid_block.h), whose rows for its own cells are
 /// exactly the whole system's; hypre solves the whole system with every rank holding its rows
-/// (hypre_pressure.h); the pressure's ghost layers are exchanged, each rank applies the gradient
-/// on its block and the velocities' ghost layers are exchanged. The result equals project() on
-/// the whole grid to the solver's tolerance.
+/// (hypre_struct_solver.h); the pressure's ghost layers are exchanged, each rank applies the
+/// gradient on its block and the velocities' ghost layers are exchanged. The result equals
+/// project() on the whole grid to the solver's tolerance.
 
 #include "fluid/grid_block.h"
 #include "fluid/pressure.h"

@@ -254,7 +254,7 @@ PressureSystemSolver::PressureSystemSolver(const PressureSystem& system,
             case PressureSolver::eigen_ic_cg:
                 break;
             case PressureSolver::hypre_pfmg_pcg: {
-                auto hypre = std::make_unique<HyprePressureSolver>(system.matrix, system.singular);
+                auto hypre = std::make_unique<HypreStructSolver>(system.matrix, system.singular);
                 m_hypre = hypre.get();
                 m_preconditioner = std::move(hypre);
                 break;
@@ -263,8 +263,8 @@ PressureSystemSolver::PressureSystemSolver(const PressureSystem& system,
         return;
     }
     m_options.solver = PressureSolver::hypre_pfmg_pcg;
-    auto hypre = std::make_unique<HyprePressureSolver>(system.matrix, system.singular,
-                                                       blocks.decomposition(), blocks.ranks());
+    auto hypre = std::make_unique<HypreStructSolver>(system.matrix, system.singular,
+                                                     blocks.decomposition(), blocks.ranks());
     m_hypre = hypre.get();
     m_preconditioner = std::move(hypre);
     m_distributed = true;

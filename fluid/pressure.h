@@ -28,7 +28,7 @@
 #include "fluid/array3.h"
 #include "fluid/boundary.h"
 #include "fluid/grid_block.h"
-#include "fluid/hypre_pressure.h"
+#include "fluid/hypre_struct_solver.h"
 #include "fluid/interface_input.h"
 #include "fluid/mac_grid.h"
 #include "fluid/mic0.h"
@@ -45,7 +45,7 @@ enum class PressureSolver {
     multigrid_pcg,  ///< PCG with a multigrid V-cycle preconditioner (TBB-parallel)
     eigen_ic_cg,    ///< reference: Eigen ConjugateGradient + IncompleteCholesky on a CSR copy
     /// hypre (libhypre-dev): HYPRE_StructPCG preconditioned by one HYPRE_StructPFMG V-cycle
-    /// (fluid/hypre_pressure.h; initialises MPI on first use). Always used on several ranks.
+    /// (fluid/hypre_struct_solver.h; initialises MPI on first use). Always used on several ranks.
     hypre_pfmg_pcg
 };
 
@@ -112,9 +112,9 @@ public:
 private:
     const PressureSystem& m_system;
     PressureOptions m_options;
-    /// null for eigen_ic_cg; for hypre_pfmg_pcg the HyprePressureSolver (one PFMG V-cycle)
+    /// null for eigen_ic_cg; for hypre_pfmg_pcg the HypreStructSolver (one PFMG V-cycle)
     std::unique_ptr<Preconditioner> m_preconditioner;
-    const HyprePressureSolver* m_hypre = nullptr;  ///< m_preconditioner's, for hypre_pfmg_pcg
+    const HypreStructSolver* m_hypre = nullptr;    ///< m_preconditioner's, for hypre_pfmg_pcg
     bool m_distributed = false;                    ///< over several ranks (hypre)
 };
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "fluid/hypre_pressure.h"
+#include "fluid/hypre_struct_solver.h"
 #include "fluid/multigrid.h"
 #include "fluid/poisson_matrix.h"
 #include "fluid/viscous_operator.h"
@@ -117,7 +117,7 @@ void ViscositySolver::distribute(const SlabDecomposition& decomposition,
 
 /// The per-component preconditioners of `options.preconditioner` (multigrid or hypre_pfmg) on
 /// the blocks of `op` (ViscousOperator::component_blocks with the workspace's diagonal).
-/// hypre: one HyprePressureSolver (a 7-point Struct system with its PFMG V-cycle) per component;
+/// hypre: one HypreStructSolver (a 7-point Struct system with its PFMG V-cycle) per component;
 /// distributed, collective, on each rank's block, w's cropped to the decomposition's layers.
 void ViscositySolver::Workspace::build_cycles(const ViscousOperator& op, bool distributed,
                                               const ViscosityOptions& options) {
@@ -133,7 +133,7 @@ void ViscositySolver::Workspace::build_cycles(const ViscousOperator& op, bool di
             continue;
         }
         if (!distributed) {
-            ws.cycles[a] = std::make_unique<HyprePressureSolver>(ws.blocks[a], false);
+            ws.cycles[a] = std::make_unique<HypreStructSolver>(ws.blocks[a], false);
             continue;
         }
         PoissonMatrix& block = ws.blocks[a];
@@ -153,7 +153,7 @@ void ViscositySolver::Workspace::build_cycles(const ViscousOperator& op, bool di
             ws.cropped = true;
         }
         ws.cycles[a] =
-            std::make_unique<HyprePressureSolver>(block, false, ws.decomposition, ws.ranks);
+            std::make_unique<HypreStructSolver>(block, false, ws.decomposition, ws.ranks);
     }
     ws.cycles_kind = options.preconditioner;
 }

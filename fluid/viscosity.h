@@ -72,7 +72,7 @@ enum class ViscousPreconditioner {
     /// 138 against 660, the same CPU); an air bubble in water (νΔt/Δx² ≈ 0.1) 12.5 instead of
     /// 17.2 and 2.3× the CPU. Not the default for that reason.
     multigrid,
-    /// one hypre PFMG V-cycle (hypre_pressure.h: a HYPRE_StructMatrix, symmetric red–black
+    /// one hypre PFMG V-cycle (hypre_struct_solver.h: a HYPRE_StructMatrix, symmetric red–black
     /// Gauss–Seidel, Galerkin coarsening) on each velocity component's block, as `multigrid`
     /// but through hypre's Struct interface; the CG around it stays ours, since the whole
     /// operator couples the three components through the shear terms, which hypre's Struct

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "fluid/forces.h"
-#include "fluid/hypre_pressure.h"
+#include "fluid/hypre_struct_solver.h"
 #include "fluid/pressure.h"
 
 namespace meniscus::fluid {

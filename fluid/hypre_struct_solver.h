@@ -1,5 +1,6 @@
 #pragma once
-/// \file The pressure Poisson system solved by hypre (Debian libhypre-dev) through its
+/// \file A symmetric 7-point system (PoissonMatrix: the pressure Poisson system, or one velocity
+/// component's block of the viscous operator) solved by hypre (Debian libhypre-dev) through its
 /// structured-grid interface: PCG (HYPRE_StructPCG) preconditioned by one PFMG V-cycle
 /// (HYPRE_StructPFMG), on one process (MPI_COMM_SELF) or on the ranks of a distributed run, each
 /// holding its slab of z-layers (slab_decomposition.h) as one box of a HYPRE_StructGrid on
@@ -35,7 +36,7 @@ namespace meniscus::fluid {
 
 /// Initialises MPI (ensure_mpi_initialized()) and hypre (HYPRE_Init) once per process, and
 /// registers HYPRE_Finalize with std::atexit (it runs before MPI_Finalize). Called by
-/// HyprePressureSolver; callable directly. Throws std::runtime_error when MPI or hypre fails.
+/// HypreStructSolver; callable directly. Throws std::runtime_error when MPI or hypre fails.
 void ensure_hypre_initialized();
 
 /// A PoissonMatrix set up once in hypre (grid, matrix, PFMG hierarchy), then solved for any
@@ -45,21 +46,21 @@ void ensure_hypre_initialized();
 ///
 /// As a Preconditioner, apply() is one PFMG V-cycle from a zero guess (symmetric red–black
 /// Gauss–Seidel, one sweep before and after, Galerkin coarse operators).
-class HyprePressureSolver final : public Preconditioner {
+class HypreStructSolver final : public Preconditioner {
 public:
     /// One process. `singular`: A is pure Neumann (null space = the constant over active cells).
     /// Throws std::invalid_argument for an empty matrix, std::runtime_error when hypre fails.
-    HyprePressureSolver(const PoissonMatrix& matrix, bool singular);
+    HypreStructSolver(const PoissonMatrix& matrix, bool singular);
     /// Collective over `ranks` (every rank constructs its own, with the same `decomposition` of
     /// the grid's z-layers over ranks.size() ranks): `block` is this rank's block of the system,
     /// decomposition.local_layers(rank) z-layers, non-periodic along z when the decomposition is
     /// distributed (the decomposition wraps instead), with at least one ghost layer. `singular`
     /// as above, for the global system. Throws std::invalid_argument when the sizes do not fit.
-    HyprePressureSolver(const PoissonMatrix& block, bool singular,
-                        const SlabDecomposition& decomposition, const RankCommunicator& ranks);
-    ~HyprePressureSolver() override;
-    HyprePressureSolver(const HyprePressureSolver&) = delete;
-    HyprePressureSolver& operator=(const HyprePressureSolver&) = delete;
+    HypreStructSolver(const PoissonMatrix& block, bool singular,
+                      const SlabDecomposition& decomposition, const RankCommunicator& ranks);
+    ~HypreStructSolver() override;
+    HypreStructSolver(const HypreStructSolver&) = delete;
+    HypreStructSolver& operator=(const HypreStructSolver&) = delete;
 
     /// Solves A x = b with hypre's PCG + PFMG from x = 0 to the relative residual
     /// ‖b − A x‖₂ / ‖b‖₂ ≤ options.tolerance (hypre's two-norm criterion on its recursively
@@ -84,7 +85,7 @@ private:
     std::unique_ptr<State> m_state;
 };
 
-/// One-shot convenience: builds a HyprePressureSolver and solves (see its solve()).
+/// One-shot convenience: builds a HypreStructSolver and solves (see its solve()).
 SolveResult solve_hypre_pfmg_pcg(const PoissonMatrix& matrix, const std::vector<double>& b,
                                  const IterativeSolverOptions& options, bool singular,
                                  std::vector<double>& x);

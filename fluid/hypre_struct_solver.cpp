@@ -1,4 +1,4 @@
-#include "fluid/hypre_pressure.h"
+#include "fluid/hypre_struct_solver.h"
 
 #include <HYPRE_struct_ls.h>
 #include <HYPRE_utilities.h>
@@ -32,8 +32,8 @@ void check(HYPRE_Int error, const char* call) {
 
 constexpr int STENCIL_SIZE = 7;
 /// Entry 0 the centre, then −x, +x, −y, +y, −z, +z.
-constexpr std::array<std::array<HYPRE_Int, 3>, STENCIL_SIZE> STENCIL_OFFSETS = {{
-    {0, 0, 0}, {-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}}};
+constexpr std::array<std::array<HYPRE_Int, 3>, STENCIL_SIZE> STENCIL_OFFSETS = {
+    {{0, 0, 0}, {-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}}};
 
 }  // namespace
 
@@ -57,7 +57,7 @@ void ensure_hypre_initialized() {
     });
 }
 
-struct HyprePressureSolver::State {
+struct HypreStructSolver::State {
     int ni = 0, nj = 0;
     int local_k = 0;  ///< z-layers of the caller's vectors (the block)
     int k_begin = 0;  ///< the block's layer of the first owned layer
@@ -137,32 +137,32 @@ struct HyprePressureSolver::State {
     }
 };
 
-HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular)
-    : HyprePressureSolver(a, singular, SlabDecomposition(std::max(a.nk(), 1)),
-                          RankCommunicator::self()) {}
+HypreStructSolver::HypreStructSolver(const PoissonMatrix& a, bool singular)
+    : HypreStructSolver(a, singular, SlabDecomposition(std::max(a.nk(), 1)),
+                        RankCommunicator::self()) {}
 
-HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular,
-                                         const SlabDecomposition& decomposition,
-                                         const RankCommunicator& ranks)
+HypreStructSolver::HypreStructSolver(const PoissonMatrix& a, bool singular,
+                                     const SlabDecomposition& decomposition,
+                                     const RankCommunicator& ranks)
     : m_state(std::make_unique<State>()) {
     if (a.size() == 0)
-        throw std::invalid_argument("HyprePressureSolver: empty matrix");
+        throw std::invalid_argument("HypreStructSolver: empty matrix");
     const int rank = ranks.rank();
     if (decomposition.ranks() != ranks.size())
-        throw std::invalid_argument("HyprePressureSolver: a decomposition over " +
+        throw std::invalid_argument("HypreStructSolver: a decomposition over " +
                                     std::to_string(decomposition.ranks()) + " ranks on " +
                                     std::to_string(ranks.size()));
     if (a.nk() != decomposition.local_layers(rank))
-        throw std::invalid_argument(
-            "HyprePressureSolver: the matrix has " + std::to_string(a.nk()) + " z-layers, rank " +
-            std::to_string(rank) + "'s block " + std::to_string(decomposition.local_layers(rank)));
+        throw std::invalid_argument("HypreStructSolver: the matrix has " + std::to_string(a.nk()) +
+                                    " z-layers, rank " + std::to_string(rank) + "'s block " +
+                                    std::to_string(decomposition.local_layers(rank)));
     const bool distributed = decomposition.distributed();
     if (distributed && decomposition.ghost_layers() < 1)
         throw std::invalid_argument(
-            "HyprePressureSolver: a distributed system needs at least one ghost layer");
+            "HypreStructSolver: a distributed system needs at least one ghost layer");
     if (distributed && a.periodic[2])
         throw std::invalid_argument(
-            "HyprePressureSolver: a rank's block does not wrap along z (the decomposition does)");
+            "HypreStructSolver: a rank's block does not wrap along z (the decomposition does)");
     ensure_hypre_initialized();
     State& s = *m_state;
     s.ni = a.ni();
@@ -215,8 +215,7 @@ HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular,
         check(HYPRE_StructStencilSetElement(s.stencil, e, offset.data()),
               "HYPRE_StructStencilSetElement");
     }
-    check(HYPRE_StructMatrixCreate(comm, s.grid, s.stencil, &s.matrix),
-          "HYPRE_StructMatrixCreate");
+    check(HYPRE_StructMatrixCreate(comm, s.grid, s.stencil, &s.matrix), "HYPRE_StructMatrixCreate");
     check(HYPRE_StructMatrixInitialize(s.matrix), "HYPRE_StructMatrixInitialize");
 
     // hypre's stencil entries are the matrix coefficients themselves, as PoissonMatrix::apply()
@@ -260,9 +259,8 @@ HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular,
                         hi[ax] = 0;
                     else
                         has_hi = false;
-                    row[1 + 2 * axis] = has_lo && is_active(lo[0], lo[1], lo[2])
-                                            ? off(lo[0], lo[1], lo[2])
-                                            : 0.0;
+                    row[1 + 2 * axis] =
+                        has_lo && is_active(lo[0], lo[1], lo[2]) ? off(lo[0], lo[1], lo[2]) : 0.0;
                     row[2 + 2 * axis] =
                         has_hi && is_active(hi[0], hi[1], hi[2]) ? off(i, j, k) : 0.0;
                 }
@@ -322,18 +320,18 @@ HyprePressureSolver::HyprePressureSolver(const PoissonMatrix& a, bool singular,
     check(HYPRE_StructPCGSetup(s.pcg, s.matrix, s.b, s.x), "HYPRE_StructPCGSetup");
 }
 
-HyprePressureSolver::~HyprePressureSolver() {
+HypreStructSolver::~HypreStructSolver() {
     std::lock_guard<std::mutex> guard(mpi_lock());
     m_state.reset();
 }
 
-SolveResult HyprePressureSolver::solve(const std::vector<double>& rhs,
-                                       const IterativeSolverOptions& options,
-                                       std::vector<double>& x) const {
+SolveResult HypreStructSolver::solve(const std::vector<double>& rhs,
+                                     const IterativeSolverOptions& options,
+                                     std::vector<double>& x) const {
     options.validate();
     State& s = *m_state;
     if (rhs.size() != s.local_size())
-        throw std::invalid_argument("HyprePressureSolver::solve: right-hand side of " +
+        throw std::invalid_argument("HypreStructSolver::solve: right-hand side of " +
                                     std::to_string(rhs.size()) + " values for " +
                                     std::to_string(s.local_size()) + " cells");
     options.cancel.throw_if_requested("the hypre PCG solve");
@@ -378,10 +376,10 @@ SolveResult HyprePressureSolver::solve(const std::vector<double>& rhs,
     return result;
 }
 
-void HyprePressureSolver::apply(const std::vector<double>& r, std::vector<double>& z) const {
+void HypreStructSolver::apply(const std::vector<double>& r, std::vector<double>& z) const {
     State& s = *m_state;
     if (r.size() != s.local_size())
-        throw std::invalid_argument("HyprePressureSolver::apply: vector of " +
+        throw std::invalid_argument("HypreStructSolver::apply: vector of " +
                                     std::to_string(r.size()) + " values for " +
                                     std::to_string(s.local_size()) + " cells");
     std::lock_guard<std::mutex> guard(mpi_lock());
@@ -392,9 +390,9 @@ void HyprePressureSolver::apply(const std::vector<double>& r, std::vector<double
     s.get_vector(s.x, z);
 }
 
-void HyprePressureSolver::remove_mean(std::vector<double>& v) const {
+void HypreStructSolver::remove_mean(std::vector<double>& v) const {
     if (v.size() != m_state->local_size())
-        throw std::invalid_argument("HyprePressureSolver::remove_mean: vector of " +
+        throw std::invalid_argument("HypreStructSolver::remove_mean: vector of " +
                                     std::to_string(v.size()) + " values for " +
                                     std::to_string(m_state->local_size()) + " cells");
     m_state->remove_mean(v);
@@ -403,7 +401,7 @@ void HyprePressureSolver::remove_mean(std::vector<double>& v) const {
 SolveResult solve_hypre_pfmg_pcg(const PoissonMatrix& matrix, const std::vector<double>& b,
                                  const IterativeSolverOptions& options, bool singular,
                                  std::vector<double>& x) {
-    return HyprePressureSolver(matrix, singular).solve(b, options, x);
+    return HypreStructSolver(matrix, singular).solve(b, options, x);
 }
 
 }  // namespace meniscus::fluid
