@@ -58,6 +58,8 @@ const char* USAGE =
     "        would, byte for byte. The scene is the one the checkpoint names (or SCENE.json); a\n"
     "        scene changed since is refused unless --allow-scene-change. --threads N (or\n"
     "        MENISCUS_THREADS) limits the worker threads.\n"
+    "        Started by mpirun -n K, a fluid scene's grid is split over K ranks (rank 0\n"
+    "        writes); its checkpoints resume on any number of ranks, or without mpirun.\n"
     "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4|A6|B1|...|B7]...\n"
     "           [--xi X]... [--curvature-operator cotangent|quartic_fit]...\n"
     "        run the validation cases — A: the paper's geometric flows (A1–A4; A5 is the cost\n"

@@ -342,10 +342,13 @@ public:
     /// counters, then adds "checkpoint": {"bytes", "seconds"} to `line` (the frame's stats).
     /// A checkpoint that cannot be written discards the frame's files from `writer` (the frame
     /// then has no stats line) and throws WriteError.
+    /// Is a checkpoint due after frame `frame`?
+    bool due(int frame) const { return m_every > 0 && (frame % m_every == 0 || frame == m_frames); }
+
     template <class SaveState>
     void write(int frame, double t, const RunResult& result, double last_dt, int stalled_steps,
                nlohmann::json& line, FrameWriter& writer, const SaveState& save) {
-        if (m_every <= 0 || (frame % m_every != 0 && frame != m_frames))
+        if (!due(frame))
             return;
         const auto start = Clock::now();
         CheckpointHeader h = m_header;
@@ -450,19 +453,18 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
     const fluid::RankCommunicator& ranks = options.ranks;
     const bool distributed = ranks.size() > 1;
     const bool root = ranks.rank() == 0;
-    if (distributed && options.resume)
-        throw InputError(
-            "--resume is not available on several MPI ranks yet (checkpoints hold "
-            "one process's state); resume without mpirun");
     const std::optional<Resume> resume = read_resume(scene, options);
     std::string report;
     double nominal_xi = 0.0;
     std::optional<coupling::Simulation> simulation;
     if (resume) {
-        prepare_output_dir(options.out_dir);
+        // A checkpoint holds the whole grid's state (Simulation::save_state): it resumes on any
+        // number of ranks, whatever number wrote it; every rank reads it.
+        if (root)
+            prepare_output_dir(options.out_dir);
         nominal_xi = resume->checkpoint.header.nominal_xi;
-        simulation.emplace(
-            make_fluid_simulation(scene, placeholder_surface(scene_periods(scene)), nominal_xi));
+        simulation.emplace(make_fluid_simulation(scene, placeholder_surface(scene_periods(scene)),
+                                                 nominal_xi, ranks));
         restore_state(*resume, options, [&](BinaryReader& in) { simulation->load_state(in); });
         report = "resumed at frame " + std::to_string(resume->checkpoint.header.frame) +
                  " from " + options.out_dir + "/" + CHECKPOINT_NAME;
@@ -482,26 +484,34 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
                                     " MPI ranks in slabs of z-layers")
                                        .c_str()
                                  : "");
-    if (distributed && scene.output.checkpoint_every > 0 && !options.quiet)
-        std::fprintf(stderr,
-                     "meniscus: warning: no checkpoints on several MPI ranks yet "
-                     "(/output/checkpoint_every is ignored)\n");
 
     const int frames =
         resume ? resume->frames : options.frames > 0 ? options.frames : scene.time.frames;
     const double frame_dt = scene.time.end / scene.time.frames;
     const double end_time = frame_dt * frames;
     std::optional<FrameWriter> frame_writer;
-    if (resume)
+    if (resume && root)
         frame_writer.emplace(scene, options.out_dir, options.quiet, frames,
                              resume->checkpoint.header, resume->bytes);
     else if (root)
         frame_writer.emplace(scene, options.out_dir, options.quiet, frames);
-    Scene checkpointed = scene;
-    if (distributed)
-        checkpointed.output.checkpoint_every = 0;
-    Checkpointer checkpointer(checkpointed, options, frames, nominal_xi);
-    const auto save = [&](BinaryWriter& out) { sim.save_state(out); };
+    Checkpointer checkpointer(scene, options, frames, nominal_xi);
+    // On several ranks saving the state is collective (the grid's fields are gathered on rank
+    // 0), so every rank saves when a checkpoint is due and rank 0 writes what it gathered.
+    std::optional<BinaryWriter> gathered;
+    const auto gather_state = [&](int frame) {
+        gathered.reset();
+        if (distributed && checkpointer.due(frame)) {
+            gathered.emplace();
+            sim.save_state(*gathered);
+        }
+    };
+    const auto save = [&](BinaryWriter& out) {
+        if (gathered)
+            out = std::move(*gathered);
+        else
+            sim.save_state(out);
+    };
     Progress progress(stderr, options.quiet);
     // The whole grid's velocities and pressure on rank 0 (gathered from every rank's slab) when
     // the VDB files need them.
@@ -554,6 +564,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
         output_clock.lap_into(times.output);
         nlohmann::json line =
             fluid_frame_stats(0, 0.0, 0, sim, last, times.json(), nlohmann::json::object());
+        gather_state(0);
         if (root) {
             checkpointer.write(0, 0.0, result, 0.0, 0, line, *frame_writer, save);
             frame_writer->stats(line);
@@ -605,6 +616,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
             progress.finish();
             std::fprintf(stderr, "%s\n", deferred.c_str());
         }
+        gather_state(frame);
         if (root) {
             checkpointer.write(frame, t, result, 0.0, 0, line, *frame_writer, save);
             frame_writer->stats(line);

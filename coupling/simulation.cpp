@@ -380,9 +380,13 @@ void Simulation::save_state(BinaryWriter& out) const {
     if (m_volumes)
         m_volumes->save_state(out);
     out.put_vector(m_vertex_velocities);
+    // φ of this rank's block; on several ranks the whole grid's, gathered on rank 0 (the fluid
+    // state is the whole grid's likewise; see FluidSolver::save_state).
     out.put<std::uint8_t>(m_phi.size() > 0 ? 1 : 0);
     if (m_phi.size() > 0)
-        fluid::save_array(out, m_phi);
+        fluid::save_array(out, m_fluid.blocks().distributed()
+                                   ? m_fluid.blocks().gather_whole(m_phi, fluid::LayerKind::cells)
+                                   : m_phi);
     for (double v : {m_boundary_volumes.liquid_in, m_boundary_volumes.gas_in,
                      m_boundary_volumes.liquid_out, m_boundary_volumes.gas_out})
         out.put(v);
@@ -407,8 +411,12 @@ void Simulation::load_state(BinaryReader& in) {
     fluid::Array3<double> phi;
     if (has_phi) {
         const fluid::MacGrid& g = m_fluid.grid();
-        phi.resize(g.nx(), g.ny(), g.nz());
+        const fluid::BlockContext& blocks = m_fluid.blocks();
+        phi.resize(g.nx(), g.ny(),
+                   blocks.distributed() ? blocks.whole_layers(fluid::LayerKind::cells) : g.nz());
         fluid::load_array(in, phi, "simulation state: phi");
+        if (blocks.distributed())
+            phi = blocks.block_of(phi, fluid::LayerKind::cells);
     }
     BoundaryVolumes through;
     for (double* v : {&through.liquid_in, &through.gas_in, &through.liquid_out, &through.gas_out}) {

@@ -146,9 +146,13 @@ public:
     const BoundaryVolumes& boundary_volumes() const { return m_boundary_volumes; }
 
     /// Exact state for checkpoints: time, tracker, fluid, volume targets, the last vertex
-    /// velocities, φ and the volumes through the open faces; a Simulation built from the same scene and given this state steps
-    /// exactly as this one would. load_state() throws FormatError on truncated or mismatched
-    /// data (then the simulation must not be stepped).
+    /// velocities, φ and the volumes through the open faces; a Simulation built from the same scene
+    /// and given this state steps exactly as this one would. load_state() throws FormatError on
+    /// truncated or mismatched data (then the simulation must not be stepped). On several ranks
+    /// both are collective and the state is the one a single process would hold: rank 0's `out`
+    /// gets the grid's fields gathered from every rank (the other ranks' `out` is not a state), and
+    /// every rank loads the whole state and keeps its block, so a state resumes on any number of
+    /// ranks.
     void save_state(BinaryWriter& out) const;
     void load_state(BinaryReader& in);
 

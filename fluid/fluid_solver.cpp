@@ -416,35 +416,92 @@ TimeStepLimits FluidSolver::time_step_limits() const {
     return compute_time_step(probe, m_options.phases, m_options.mode, m_options.time_step);
 }
 
+namespace {
+
+LayerKind velocity_layers(int axis) {
+    return axis == 2 ? LayerKind::z_faces : LayerKind::cells;
+}
+
+/// Liquid flags as a cell field (a distributed run gathers and splits fields of doubles).
+Array3<double> flags_field(const std::vector<char>& flags, const Array3<double>& shape) {
+    Array3<double> field(shape.ni(), shape.nj(), shape.nk(), 0.0);
+    for (std::size_t c = 0; c < flags.size() && c < field.size(); ++c)
+        field[c] = flags[c] ? 1.0 : 0.0;
+    return field;
+}
+
+std::vector<char> field_flags(const Array3<double>& field) {
+    std::vector<char> flags(field.size());
+    for (std::size_t c = 0; c < field.size(); ++c)
+        flags[c] = field[c] != 0.0 ? 1 : 0;
+    return flags;
+}
+
+}  // namespace
+
+// On several ranks both are collective and the state is the whole grid's, in the one-process
+// layout: rank 0 writes the arrays gathered from every rank's owned layers, and each rank loads
+// the whole arrays and keeps its block. A checkpoint so resumes on any number of ranks.
 void FluidSolver::save_state(BinaryWriter& out) const {
-    for (int axis = 0; axis < 3; ++axis)
-        save_array(out, m_grid.velocity(axis));
-    save_array(out, m_pressure);
+    for (int axis = 0; axis < 3; ++axis) {
+        if (m_blocks.distributed())
+            save_array(out, m_blocks.gather_whole(m_grid.velocity(axis), velocity_layers(axis)));
+        else
+            save_array(out, m_grid.velocity(axis));
+    }
+    if (m_blocks.distributed())
+        save_array(out, m_blocks.gather_whole(m_pressure, LayerKind::cells));
+    else
+        save_array(out, m_pressure);
     out.put<std::uint8_t>(m_increment.size() > 0 ? 1 : 0);
-    if (m_increment.size() > 0)
-        save_array(out, m_increment);
-    out.put_vector(m_was_liquid);
+    if (m_increment.size() > 0) {
+        if (m_blocks.distributed())
+            save_array(out, m_blocks.gather_whole(m_increment, LayerKind::cells));
+        else
+            save_array(out, m_increment);
+    }
+    if (m_blocks.distributed() && !m_was_liquid.empty())
+        out.put_vector(field_flags(
+            m_blocks.gather_whole(flags_field(m_was_liquid, m_pressure), LayerKind::cells)));
+    else
+        out.put_vector(m_was_liquid);
     out.put(m_time);
 }
 
 void FluidSolver::load_state(BinaryReader& in) {
-    std::array<Array3<double>, 3> velocity{m_grid.u(), m_grid.v(), m_grid.w()};
+    const bool distributed = m_blocks.distributed();
+    // Reads an array shaped like `block` (its block) or, distributed, like the whole field, and
+    // returns this rank's block of it.
+    const auto load_block = [&](const Array3<double>& block, LayerKind kind, const char* what) {
+        Array3<double> a(block.ni(), block.nj(),
+                         distributed ? m_blocks.whole_layers(kind) : block.nk(), 0.0);
+        load_array(in, a, what);
+        return m_blocks.block_of(a, kind);
+    };
+    std::array<Array3<double>, 3> velocity;
     const char* names[] = {"fluid state: u", "fluid state: v", "fluid state: w"};
     for (int axis = 0; axis < 3; ++axis)
-        load_array(in, velocity[static_cast<size_t>(axis)], names[axis]);
-    Array3<double> pressure = m_pressure;
-    load_array(in, pressure, "fluid state: pressure");
+        velocity[static_cast<size_t>(axis)] =
+            load_block(m_grid.velocity(axis), velocity_layers(axis), names[axis]);
+    Array3<double> pressure = load_block(m_pressure, LayerKind::cells, "fluid state: pressure");
     Array3<double> increment;
     const std::uint8_t has_increment = in.get<std::uint8_t>();
     if (has_increment > 1)
         throw FormatError("fluid state: bad increment flag");
-    if (has_increment) {
-        increment = m_pressure;
-        load_array(in, increment, "fluid state: pressure increment");
-    }
+    if (has_increment)
+        increment = load_block(m_pressure, LayerKind::cells, "fluid state: pressure increment");
     std::vector<char> was_liquid = in.get_vector<char>();
-    if (!was_liquid.empty() && was_liquid.size() != m_pressure.size())
+    const std::size_t cells =
+        static_cast<std::size_t>(m_pressure.ni()) * m_pressure.nj() *
+        (distributed ? m_blocks.whole_layers(LayerKind::cells) : m_pressure.nk());
+    if (!was_liquid.empty() && was_liquid.size() != cells)
         throw FormatError("fluid state: the liquid flags do not match the grid");
+    if (distributed && !was_liquid.empty()) {
+        Array3<double> whole(m_pressure.ni(), m_pressure.nj(),
+                             m_blocks.whole_layers(LayerKind::cells), 0.0);
+        was_liquid =
+            field_flags(m_blocks.block_of(flags_field(was_liquid, whole), LayerKind::cells));
+    }
     const double time = in.get<double>();
     if (!std::isfinite(time) || time < 0.0)
         throw FormatError("fluid state: the time is not a number >= 0");

@@ -153,6 +153,9 @@ public:
     /// Exact state for checkpoints: the face velocities, the pressure the next step starts
     /// from, its increment and the last step's liquid cells. load_state() needs a solver built
     /// with the same grid and options and throws FormatError on truncated or mismatched data.
+    /// On several ranks both are collective and the state is the whole grid's (rank 0's `out`
+    /// gets the fields gathered from every rank; every rank loads the whole fields and keeps
+    /// its block), in the one-process layout.
     void save_state(BinaryWriter& out) const;
     void load_state(BinaryReader& in);
 

@@ -45,6 +45,22 @@ void BlockContext::exchange(MacGrid& block) const {
         exchange_velocity_halos(block, m_decomposition, m_ranks);
 }
 
+Array3<double> BlockContext::gather_whole(const Array3<double>& block, LayerKind kind) const {
+    if (!distributed())
+        return block;
+    return gather_field(block, m_decomposition, m_ranks, kind, 0);
+}
+
+Array3<double> BlockContext::block_of(const Array3<double>& whole, LayerKind kind) const {
+    if (!distributed())
+        return whole;
+    if (whole.nk() != whole_layers(kind))
+        throw std::invalid_argument("BlockContext::block_of: a field of " +
+                                    std::to_string(whole.nk()) + " z-layers, the grid has " +
+                                    std::to_string(whole_layers(kind)));
+    return extract_block(whole, m_decomposition, rank(), kind);
+}
+
 std::size_t BlockContext::owned_cells_begin(std::size_t layer) const {
     if (!distributed())
         return 0;

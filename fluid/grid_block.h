@@ -45,6 +45,16 @@ public:
     /// The range [begin, end) of the flat indices of the owned cells of a block cell vector.
     std::size_t owned_cells_begin(std::size_t layer) const;
     std::size_t owned_cells_end(std::size_t layer) const;
+    /// Collective: the whole field of `kind` assembled from every rank's owned layers on rank 0
+    /// (an empty array on the others); one process: a copy of `block`.
+    Array3<double> gather_whole(const Array3<double>& block, LayerKind kind) const;
+    /// This rank's block (ghost layers included) of a field of `kind` held whole; one process: a
+    /// copy. Throws std::invalid_argument when `whole` does not have the decomposition's layers.
+    Array3<double> block_of(const Array3<double>& whole, LayerKind kind) const;
+    /// z-layers of the whole field of `kind` (the decomposition's, one more for z-faces).
+    int whole_layers(LayerKind kind) const {
+        return m_decomposition.layers() + (kind == LayerKind::z_faces ? 1 : 0);
+    }
     double sum(double value) const { return m_ranks.sum(value); }
     double max(double value) const { return m_ranks.max(value); }
     double min(double value) const { return m_ranks.min(value); }

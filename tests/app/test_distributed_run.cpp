@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -34,12 +35,8 @@ Json shipped_scene(const std::string& name) {
     return Json::parse(in);
 }
 
-/// Runs `scene` into `out`: alone (ranks 0) or under mpirun on `ranks` ranks, one thread each.
-ChildResult run(const Json& scene, const fs::path& out, int ranks) {
-    fs::remove_all(out);
-    fs::create_directories(out.parent_path());
-    const fs::path scene_path = out.string() + ".json";
-    std::ofstream(scene_path) << scene.dump(2);
+/// Runs `meniscus ARGS --threads 1`: alone (ranks 0) or under mpirun on `ranks` ranks.
+ChildResult run_meniscus(std::vector<std::string> args, int ranks, const fs::path& log) {
     // Containers often lack the ptrace rights of Open MPI's single-copy shared memory; ranks
     // waiting in a collective yield the core (3 ranks share 2 here).
     setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
@@ -53,13 +50,30 @@ ChildResult run(const Json& scene, const fs::path& out, int ranks) {
                 "none",
                 "-n",
                 std::to_string(ranks)};
-    for (const std::string& a :
-         {std::string(MENISCUS_BINARY), std::string("run"), scene_path.string(),
-          std::string("--out"), out.string(), std::string("--threads"), std::string("1")})
-        argv.push_back(a);
+    argv.push_back(MENISCUS_BINARY);
+    args.insert(args.end(), {"--threads", "1"});
+    argv.insert(argv.end(), args.begin(), args.end());
     ChildLimits limits;
     limits.wall_seconds = 600.0;
-    return run_child(argv, limits, out.string() + ".log");
+    return run_child(argv, limits, log.string());
+}
+
+/// Runs `scene` into `out` (see run_meniscus()), with `extra` arguments.
+ChildResult run(const Json& scene, const fs::path& out, int ranks,
+                const std::vector<std::string>& extra = {}) {
+    fs::remove_all(out);
+    fs::create_directories(out.parent_path());
+    const fs::path scene_path = out.string() + ".json";
+    std::ofstream(scene_path) << scene.dump(2);
+    std::vector<std::string> args = {"run", scene_path.string(), "--out", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_meniscus(args, ranks, out.string() + ".log");
+}
+
+/// Continues the run in `dir` from its checkpoint to frame `frames` (see run_meniscus()).
+ChildResult resume(const fs::path& dir, int ranks, int frames) {
+    return run_meniscus({"run", "--resume", dir.string(), "--frames", std::to_string(frames)},
+                        ranks, dir.string() + ".resume.log");
 }
 
 std::vector<Json> stats(const fs::path& out) {
@@ -188,6 +202,68 @@ TEST(DistributedRun, BubbleMergeWithTheViscousSolveOnHypre) {
     scene["time"] = {{"end", 0.004}, {"frames", 4}};
     scene["output"] = {{"ply", true}, {"vdb", true}};
     expect_same_run("bubble_merge_viscous_hypre", scene, 2, 2);
+}
+
+TEST(DistributedRun, CheckpointsResumeOnAnyNumberOfRanks) {
+    // A checkpoint holds the whole grid's state whatever number of ranks wrote it: a run stopped
+    // at frame 2 and resumed on the same ranks ends exactly as the run that did not stop; resumed
+    // on another number of ranks (or one process), as a run on that number does.
+    Json scene = with_hypre(shipped_scene("bubble_merge"));
+    scene["time"] = {{"end", 0.004}, {"frames", 4}};
+    scene["output"] = {{"ply", true}, {"vdb", false}, {"checkpoint_every", 1}};
+    const fs::path dir = fs::temp_directory_path() / "meniscus_distributed_resume";
+    const std::vector<double> size = scene["domain"]["size"];
+    const double domain = *std::max_element(size.begin(), size.end());
+    const auto expect_ok = [](const ChildResult& r) {
+        EXPECT_TRUE(r.exited && r.exit_code == 0) << r.output;
+    };
+    expect_ok(run(scene, dir / "whole_2", 2));
+    // What every run writes per frame but its wall-clock times and the checkpoint's size (it
+    // holds the scene's path, whose length differs between the folders).
+    const auto physics = [](const fs::path& out) {
+        std::vector<Json> lines = stats(out);
+        for (Json& line : lines)
+            for (const char* key : {"seconds", "times", "checkpoint"})
+                line.erase(key);
+        return lines;
+    };
+    const auto frame_4 = [](const fs::path& out) {
+        return meniscus::tracker::read_ply((out / "surface_0004.ply").string());
+    };
+    struct Case {
+        const char* name;
+        int first_ranks, then_ranks;
+    };
+    for (const Case& c : {Case{"2_then_2", 2, 2}, Case{"2_then_1", 2, 0}, Case{"1_then_3", 0, 3}}) {
+        const fs::path out = dir / c.name;
+        expect_ok(run(scene, out, c.first_ranks, {"--frames", "2"}));
+        expect_ok(resume(out, c.then_ranks, 4));
+        const std::vector<Json> resumed = physics(out), whole = physics(dir / "whole_2");
+        ASSERT_EQ(resumed.size(), 5u) << c.name;
+        ASSERT_EQ(whole.size(), 5u) << c.name;
+        if (c.first_ranks == 2 && c.then_ranks == 2) {
+            EXPECT_EQ(resumed, whole) << c.name;
+            std::ifstream a(out / "surface_0004.ply", std::ios::binary),
+                b(dir / "whole_2" / "surface_0004.ply", std::ios::binary);
+            EXPECT_TRUE(std::equal(std::istreambuf_iterator<char>(a), {},
+                                   std::istreambuf_iterator<char>(b), {}))
+                << c.name << ": the last frame's PLY differs";
+            continue;
+        }
+        for (std::size_t f = 0; f < whole.size(); ++f) {
+            EXPECT_EQ(resumed[f]["steps"], whole[f]["steps"]) << c.name << ", frame " << f;
+            EXPECT_EQ(resumed[f]["components"], whole[f]["components"]) << c.name;
+        }
+        const meniscus::tracker::MeshData a = frame_4(out), b = frame_4(dir / "whole_2");
+        ASSERT_EQ(a.positions.size(), b.positions.size()) << c.name;
+        double shift = 0.0;
+        for (std::size_t v = 0; v < a.positions.size(); ++v)
+            shift = std::max(shift, (a.positions[v] - b.positions[v]).norm());
+        EXPECT_LE(shift, 1e-9 * domain) << c.name;
+        std::printf("%s: frame 4 within %.3g of the domain of the run on 2 ranks\n", c.name,
+                    shift / domain);
+    }
+    fs::remove_all(dir);
 }
 
 TEST(DistributedRun, JetPinchPinchesAtTheSameFrame) {

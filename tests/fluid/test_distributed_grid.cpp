@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "common/binary_io.h"
 #include "fluid/distributed_projection.h"
 #include "fluid/fluid_solver.h"
 #include "fluid/grid_block.h"
@@ -395,7 +396,53 @@ struct StepCase {
     FluidMode mode;
     bool periodic_z;
     ViscousPreconditioner viscous = ViscousPreconditioner::jacobi;  ///< on both sides
+    /// also checks that the states (checkpoints) move between the ranks and one process
+    bool check_state = false;
 };
+
+/// The state of the split solver (gathered on rank 0) loads into a solver on one process, which
+/// saves the same bytes and holds the whole solver's fields; the whole solver's state loads into
+/// a split solver, which then holds exactly their blocks and steps as the whole one does.
+void expect_states_move(FluidSolver& whole, const FluidSolver& split,
+                        const InterfaceInput& interface, const InterfaceInput& block_interface,
+                        const StepCase& c) {
+    const RankCommunicator world = ranks();
+    const FluidOptions& options = whole.options();
+    const MacGrid& g = whole.grid();
+    const SlabDecomposition& d = split.blocks().decomposition();
+    const int rank = world.rank();
+    BinaryWriter gathered;
+    split.save_state(gathered);  // collective
+    if (rank == 0) {
+        FluidSolver alone(g.nx(), g.ny(), g.nz(), DX, Eigen::Vector3d::Zero(), options);
+        BinaryReader in(gathered.bytes().data(), gathered.bytes().size());
+        alone.load_state(in);
+        EXPECT_TRUE(in.at_end()) << c.name;
+        BinaryWriter again;
+        alone.save_state(again);
+        EXPECT_EQ(again.bytes(), gathered.bytes()) << c.name;
+        const Deviation u = deviation(alone.grid(), g);
+        EXPECT_LE(u.difference, AGREEMENT * u.scale) << c.name;
+    }
+    BinaryWriter state;
+    whole.save_state(state);  // one process: every rank holds the same whole solver
+    FluidSolver loaded(g.nx(), g.ny(), g.nz(), DX, Eigen::Vector3d::Zero(), options, d, world);
+    BinaryReader in(state.bytes().data(), state.bytes().size());
+    loaded.load_state(in);  // collective
+    EXPECT_TRUE(in.at_end()) << c.name;
+    for (int axis = 0; axis < 3; ++axis)
+        EXPECT_EQ(loaded.grid().velocity(axis).storage(),
+                  extract_block_grid(g, d, rank).velocity(axis).storage())
+            << c.name << ", rank " << rank << ", axis " << axis;
+    EXPECT_EQ(loaded.pressure().storage(),
+              extract_block(whole.pressure(), d, rank, LayerKind::cells).storage())
+        << c.name << ", rank " << rank;
+    const double dt = std::min(2e-4, whole.time_step_limits().dt);
+    whole.step(dt, interface);
+    loaded.step(dt, block_interface);
+    const Deviation u = deviation(loaded.grid(), extract_block_grid(whole.grid(), d, rank));
+    EXPECT_LE(u.difference, AGREEMENT * u.scale) << c.name << ", rank " << rank;
+}
 
 /// Steps of the whole fluid solver on one process against the same solver split over the ranks:
 /// a viscous bubble (drop in free-surface mode) under gravity with the σκ jump, stirred, for
@@ -463,6 +510,8 @@ void expect_steps_match(const StepCase& c) {
         deviation(split.pressure().storage(),
                   extract_block(whole.pressure(), d, world.rank(), LayerKind::cells).storage());
     EXPECT_LE(p.difference, AGREEMENT * p.scale) << c.name << ", rank " << world.rank();
+    if (c.check_state)
+        expect_states_move(whole, split, interface, block_interface, c);
 }
 
 TEST(DistributedFluidSolver, CoupledViscousBubbleStepsAsOnOneProcess) {
@@ -477,6 +526,13 @@ TEST(DistributedFluidSolver, SplitStepsWithTheViscousSolveOnHypre) {
 TEST(DistributedFluidSolver, SplitStepsAcrossAPeriodicSeam) {
     expect_steps_match(
         {"split periodic", ViscousPressureCoupling::split, FluidMode::two_phase, true});
+}
+
+TEST(DistributedFluidSolver, StatesMoveBetweenRanksAndOneProcessAcrossAPeriodicSeam) {
+    expect_steps_match({"state, free surface, periodic", ViscousPressureCoupling::coupled,
+                        FluidMode::free_surface, true, ViscousPreconditioner::jacobi, true});
+    expect_steps_match({"state, two-phase", ViscousPressureCoupling::coupled, FluidMode::two_phase,
+                        false, ViscousPreconditioner::jacobi, true});
 }
 
 TEST(DistributedFluidSolver, FreeSurfaceDropStepsAsOnOneProcess) {
