@@ -10,7 +10,8 @@
 // each other as in bubble_merge, with T TBB threads (tbb::global_control). One untimed step
 // first (it builds the first pressure and the solver's workspaces), then
 // MENISCUS_BENCH_CUBE_STEPS timed steps (default 3); MENISCUS_BENCH_SCHUR sets
-// /fluid/viscous_pressure/preconditioner (default v_cycle, as scenes).
+// /fluid/viscous_pressure/preconditioner (default v_cycle, as scenes); MENISCUS_BENCH_FLUID
+// replaces that by any /fluid keys.
 //
 // Counters: <phase>_cpu_us and <phase>_wall_us, µs per cell per step, for the coupling's phases
 // (rasterize, curvature, fluid, interpolate, volume_correction, tracker), the fluid step's
@@ -65,8 +66,12 @@ app::Scene refined_scene(const std::string& name, int cells) {
     return scene;
 }
 
-/// bubble_pair_cube.h's scene with MENISCUS_BENCH_SCHUR's Schur preconditioner.
+/// bubble_pair_cube.h's scene with MENISCUS_BENCH_SCHUR's Schur preconditioner, or with the
+/// /fluid keys of MENISCUS_BENCH_FLUID instead (JSON members, e.g. `"viscosity_scheme":
+/// "explicit_when_stable", "viscous_pressure": {"coupling": "split"}`).
 app::Scene bubble_pair_cube(int cells) {
+    if (const char* fluid = std::getenv("MENISCUS_BENCH_FLUID"))
+        return bench::bubble_pair_cube(cells, fluid);
     const char* schur_env = std::getenv("MENISCUS_BENCH_SCHUR");
     const std::string schur = schur_env != nullptr ? schur_env : "v_cycle";
     return bench::bubble_pair_cube(cells,
