@@ -338,13 +338,13 @@ public:
         m_header.nominal_xi = nominal_xi;
     }
 
+    /// Is a checkpoint due after frame `frame`?
+    bool due(int frame) const { return m_every > 0 && (frame % m_every == 0 || frame == m_frames); }
+
     /// If frame `frame` is due, writes the checkpoint with `save` as its state and the run's
     /// counters, then adds "checkpoint": {"bytes", "seconds"} to `line` (the frame's stats).
     /// A checkpoint that cannot be written discards the frame's files from `writer` (the frame
     /// then has no stats line) and throws WriteError.
-    /// Is a checkpoint due after frame `frame`?
-    bool due(int frame) const { return m_every > 0 && (frame % m_every == 0 || frame == m_frames); }
-
     template <class SaveState>
     void write(int frame, double t, const RunResult& result, double last_dt, int stalled_steps,
                nlohmann::json& line, FrameWriter& writer, const SaveState& save) {
@@ -569,6 +569,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
             checkpointer.write(0, 0.0, result, 0.0, 0, line, *frame_writer, save);
             frame_writer->stats(line);
         }
+        gathered.reset();  // the other ranks' copy is not a state
         result.frames_written = 1;
     }
     for (int frame = first_frame; frame <= frames; ++frame) {
@@ -621,6 +622,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
             checkpointer.write(frame, t, result, 0.0, 0, line, *frame_writer, save);
             frame_writer->stats(line);
         }
+        gathered.reset();  // the other ranks' copy is not a state
         const std::string warning = solves.warning(frame, steps);
         if (!warning.empty() && !options.quiet) {
             progress.finish();
