@@ -10,42 +10,53 @@ namespace meniscus::app {
 
 using tracker::SurfaceMesh;
 
-nlohmann::json frame_stats(int frame, double time, double dt, long long steps,
-                           const SurfaceMesh& mesh, const FrameWork& work) {
+namespace {
+
+/// The surface's part of both kinds of line: its counts and volumes (m³), total and per component.
+/// (nlohmann::json keeps an object's keys sorted, so merging it changes no line's text.)
+nlohmann::json surface_stats(const SurfaceMesh& mesh) {
     const auto components = tracker::triangle_components(mesh);
-    const auto volumes = tracker::component_volumes(mesh, components);
+    const std::vector<double> volumes = tracker::component_volumes(mesh, components);
     double total = 0.0;
     for (double v : volumes)
         total += v;
-    const auto edges = tracker::edge_length_stats(mesh);
-    const auto angles = tracker::angle_stats(mesh);
-    return {{"frame", frame},
-            {"time", time},
-            {"dt", dt},
-            {"steps", steps},
-            {"vertices", mesh.count_live_vertices()},
+    return {{"vertices", mesh.count_live_vertices()},
             {"triangles", mesh.count_live_triangles()},
             {"components", components.count},
             {"volume", total},
-            {"component_volumes", volumes},
-            {"mean_edge_length", edges.mean},
-            {"min_angle_degrees", angles.min_degrees},
-            {"max_angle_degrees", angles.max_degrees},
-            {"collisions_found", work.collisions_found},
-            {"impact_zone_iterations", work.impact_zone_iterations},
-            {"step_shortenings", work.step_shortenings},
-            {"flow_step_shortenings", work.flow_shortenings},
-            {"intersecting_pairs", work.intersecting_pairs},
-            {"volume_change_by_phase",
-             {{"remeshing", work.volume_remeshing},
-              {"motion", work.volume_motion},
-              {"collisions", work.volume_collisions}}},
-            {"seconds",
-             {{"improvement", work.improvement},
-              {"topology", work.topology},
-              {"set_velocity", work.set_velocity},
-              {"collisions", work.collisions},
-              {"output", work.output}}}};
+            {"component_volumes", volumes}};
+}
+
+}  // namespace
+
+nlohmann::json frame_stats(int frame, double time, double dt, long long steps,
+                           const SurfaceMesh& mesh, const FrameWork& work) {
+    const auto edges = tracker::edge_length_stats(mesh);
+    const auto angles = tracker::angle_stats(mesh);
+    nlohmann::json line = {{"frame", frame},
+                           {"time", time},
+                           {"dt", dt},
+                           {"steps", steps},
+                           {"mean_edge_length", edges.mean},
+                           {"min_angle_degrees", angles.min_degrees},
+                           {"max_angle_degrees", angles.max_degrees},
+                           {"collisions_found", work.collisions_found},
+                           {"impact_zone_iterations", work.impact_zone_iterations},
+                           {"step_shortenings", work.step_shortenings},
+                           {"flow_step_shortenings", work.flow_shortenings},
+                           {"intersecting_pairs", work.intersecting_pairs},
+                           {"volume_change_by_phase",
+                            {{"remeshing", work.volume_remeshing},
+                             {"motion", work.volume_motion},
+                             {"collisions", work.volume_collisions}}},
+                           {"seconds",
+                            {{"improvement", work.improvement},
+                             {"topology", work.topology},
+                             {"set_velocity", work.set_velocity},
+                             {"collisions", work.collisions},
+                             {"output", work.output}}}};
+    line.update(surface_stats(mesh));
+    return line;
 }
 
 void FluidFrameTimes::add(const coupling::SimulationStepReport& step) {
@@ -167,12 +178,7 @@ nlohmann::json fluid_frame_stats(int frame, double time, long long steps,
                                  const coupling::Simulation& sim,
                                  const coupling::SimulationStepReport& last,
                                  const nlohmann::json& seconds, const nlohmann::json& work) {
-    const SurfaceMesh& mesh = sim.tracker().mesh();
-    const auto components = tracker::triangle_components(mesh);
-    const auto volumes = tracker::component_volumes(mesh, components);
-    double total = 0.0, max_speed = 0.0;
-    for (double v : volumes)
-        total += v;
+    double max_speed = 0.0;
     const fluid::MacGrid& grid = sim.fluid().grid();
     for (int axis = 0; axis < 3; ++axis) {
         const fluid::Array3<double>& u = grid.velocity(axis);
@@ -187,17 +193,13 @@ nlohmann::json fluid_frame_stats(int frame, double time, long long steps,
                            {"dt", last.dt},
                            {"dt_limit", coupling::to_string(last.limit)},
                            {"steps", steps},
-                           {"vertices", mesh.count_live_vertices()},
-                           {"triangles", mesh.count_live_triangles()},
-                           {"components", components.count},
-                           {"volume", total},
-                           {"component_volumes", volumes},
                            {"volume_targets", last.volume.targets},
                            {"kinetic_energy", sim.kinetic_energy()},
                            {"max_speed", max_speed},
                            {"pressure_iterations", last.fluid.pressure.iterations},
                            {"pressure_converged", last.fluid.pressure.converged},
                            {"seconds", seconds}};
+    line.update(surface_stats(sim.tracker().mesh()));
     line.update(work);
     return line;
 }

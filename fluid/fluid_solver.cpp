@@ -443,23 +443,19 @@ std::vector<char> field_flags(const Array3<double>& field) {
 // layout: rank 0 writes the arrays gathered from every rank's owned layers, and each rank loads
 // the whole arrays and keeps its block. A checkpoint so resumes on any number of ranks.
 void FluidSolver::save_state(BinaryWriter& out) const {
-    for (int axis = 0; axis < 3; ++axis) {
+    // The whole field (gathered on several ranks; one process writes its own without a copy).
+    const auto save_whole = [&](const Array3<double>& block, LayerKind kind) {
         if (m_blocks.distributed())
-            save_array(out, m_blocks.gather_whole(m_grid.velocity(axis), velocity_layers(axis)));
+            save_array(out, m_blocks.gather_whole(block, kind));
         else
-            save_array(out, m_grid.velocity(axis));
-    }
-    if (m_blocks.distributed())
-        save_array(out, m_blocks.gather_whole(m_pressure, LayerKind::cells));
-    else
-        save_array(out, m_pressure);
+            save_array(out, block);
+    };
+    for (int axis = 0; axis < 3; ++axis)
+        save_whole(m_grid.velocity(axis), velocity_layers(axis));
+    save_whole(m_pressure, LayerKind::cells);
     out.put<std::uint8_t>(m_increment.size() > 0 ? 1 : 0);
-    if (m_increment.size() > 0) {
-        if (m_blocks.distributed())
-            save_array(out, m_blocks.gather_whole(m_increment, LayerKind::cells));
-        else
-            save_array(out, m_increment);
-    }
+    if (m_increment.size() > 0)
+        save_whole(m_increment, LayerKind::cells);
     if (m_blocks.distributed() && !m_was_liquid.empty())
         out.put_vector(field_flags(
             m_blocks.gather_whole(flags_field(m_was_liquid, m_pressure), LayerKind::cells)));

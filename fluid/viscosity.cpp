@@ -86,11 +86,10 @@ struct ViscositySolver::Workspace {
     std::vector<double> u_star, fixed, x, b, r, z, p, q, diagonal;
     /// multigrid, hypre_pfmg: the component blocks and their V-cycles (built on first use
     /// after `op`, of the kind `cycles_kind`). Distributed, the block of w stops below its top
-    /// face layer (`cropped`), so that it has the decomposition's z-layers as hypre needs.
+    /// face layer, so that it has the decomposition's z-layers as hypre needs.
     std::array<PoissonMatrix, 3> blocks;
     std::array<std::unique_ptr<Preconditioner>, 3> cycles;
     ViscousPreconditioner cycles_kind = ViscousPreconditioner::jacobi;
-    bool cropped = false;
 
     void build_cycles(const ViscousOperator& op, bool distributed, const ViscosityOptions& options);
     std::array<std::vector<double>, 3> block_r, block_z;
@@ -123,7 +122,6 @@ void ViscositySolver::Workspace::build_cycles(const ViscousOperator& op, bool di
                                               const ViscosityOptions& options) {
     Workspace& ws = *this;
     op.component_blocks(ws.diagonal, ws.blocks);
-    ws.cropped = false;
     const int rank = ws.ranks.rank();
     for (std::size_t a = 0; a < 3; ++a) {
         ws.cycles[a].reset();
@@ -150,7 +148,6 @@ void ViscositySolver::Workspace::build_cycles(const ViscousOperator& op, bool di
                         cropped.off_z(i, j, k) = k + 1 < layers ? block.off_z(i, j, k) : 0.0;
                     }
             block = std::move(cropped);
-            ws.cropped = true;
         }
         ws.cycles[a] =
             std::make_unique<HypreStructSolver>(block, false, ws.decomposition, ws.ranks);
