@@ -13,6 +13,7 @@
 #include "fluid/hypre_struct_solver.h"
 #include "fluid/multigrid.h"
 #include "fluid/poisson_matrix.h"
+#include "fluid/surface_preconditioner.h"
 #include "fluid/viscous_operator.h"
 
 namespace meniscus::fluid {
@@ -90,6 +91,9 @@ struct ViscositySolver::Workspace {
     std::array<PoissonMatrix, 3> blocks;
     std::array<std::unique_ptr<Preconditioner>, 3> cycles;
     ViscousPreconditioner cycles_kind = ViscousPreconditioner::jacobi;
+    /// jacobi with the implicit tension's surface term: the diagonal made exact for that term
+    /// (built on first use after `op`)
+    SurfacePreconditioner surface_jacobi;
 
     void build_cycles(const ViscousOperator& op, bool distributed, const ViscosityOptions& options);
     std::array<std::vector<double>, 3> block_r, block_z;
@@ -194,6 +198,7 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         ws.diagonal.clear();
         for (auto& cycle : ws.cycles)
             cycle.reset();
+        ws.surface_jacobi = SurfacePreconditioner();
         op.build(grid, interface.phi, viscous_phases, mode, walls, dt, min_liquid_fraction,
                  options.weights, surface.get());
         key.phi = interface.phi.storage();
@@ -293,11 +298,24 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         const ViscousPreconditioner kind = options.preconditioner;
         if (kind != ViscousPreconditioner::jacobi && (!ws.cycles[0] || ws.cycles_kind != kind))
             ws.build_cycles(op, distributed, options);
+        // Past the capillary limit the surface term outweighs the gas faces' mass along the
+        // surface, which the diagonal alone leaves to hundreds of iterations: Jacobi then takes
+        // D + Sᵀ B S whole (surface_preconditioner.h).
+        const bool surface_jacobi = kind == ViscousPreconditioner::jacobi && surface;
+        if (surface_jacobi && !ws.surface_jacobi.built()) {
+            std::vector<double> grid_diagonal;
+            op.diagonal(grid_diagonal, false);
+            ws.surface_jacobi.build(*surface, op.surface_scale(), grid_diagonal, unknown);
+        }
         // z = M⁻¹ r: Jacobi, or a V-cycle on each component's block (r is zero on fixed faces,
         // and so is z). The layer of w's faces left out of a cropped block (the top face of the
         // last rank's block, solved for only below an outflow; a ghost layer elsewhere) takes
         // the diagonal.
         const auto precondition = [&]() {
+            if (surface_jacobi) {
+                ws.surface_jacobi.apply(r, z);
+                return;
+            }
             if (kind == ViscousPreconditioner::jacobi) {
                 for (std::size_t f = 0; f < n; ++f)
                     z[f] = r[f] / diagonal[f];

@@ -63,7 +63,9 @@ enum class ViscosityWeights {
 
 /// Preconditioner of the viscous conjugate gradients.
 enum class ViscousPreconditioner {
-    jacobi,  ///< the operator's diagonal
+    /// the operator's diagonal; with semi-implicit tension's surface term, the diagonal plus
+    /// that term, inverted exactly (surface_preconditioner.h)
+    jacobi,
     /// one multigrid V-cycle (multigrid.h) on each velocity component's own block of the
     /// operator (its couplings to the other components left out). Pays where the viscous
     /// diffusion number νΔt/Δx² is large, since an iteration costs about 3.5 Jacobi ones: a

@@ -131,7 +131,7 @@ void ViscousOperator::apply(const std::vector<double>& x, std::vector<double>& y
     }
 }
 
-void ViscousOperator::diagonal(std::vector<double>& d) const {
+void ViscousOperator::diagonal(std::vector<double>& d, bool with_surface) const {
     d.assign(m_size, 1.0);
     const double inv_dx2 = 1.0 / (m_dx * m_dx);
     for (int a = 0; a < 3; ++a) {
@@ -166,7 +166,7 @@ void ViscousOperator::diagonal(std::vector<double>& d) const {
             d[flat] = sum;
         });
     }
-    if (m_surface) {
+    if (m_surface && with_surface) {
         std::vector<double> surface(m_size, 0.0);
         m_surface->add_diagonal_bound(m_surface_scale, surface);
         for (std::size_t f = 0; f < m_size; ++f)

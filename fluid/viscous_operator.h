@@ -51,8 +51,14 @@ public:
     /// y = (ρ + K) x restricted to the unknowns (x must vanish on fixed faces; y does too).
     void apply(const std::vector<double>& x, std::vector<double>& y) const;
 
-    /// Diagonal of ρ + K on the unknowns (1 on fixed faces), for Jacobi preconditioning.
-    void diagonal(std::vector<double>& d) const;
+    /// Diagonal of ρ + K on the unknowns (1 on fixed faces), for Jacobi preconditioning; with
+    /// `with_surface` false, that of the grid part alone (the surface term's left out, for
+    /// SurfacePreconditioner, which takes that term whole).
+    void diagonal(std::vector<double>& d, bool with_surface = true) const;
+
+    /// The implicit tension's term and its scale Δt μ_s / Δx³ in K (null when there is none).
+    const SurfaceViscosity* surface() const { return m_surface; }
+    double surface_scale() const { return m_surface_scale; }
 
     /// The diagonal blocks of ρ + K, each velocity component coupled with itself alone (the
     /// normal-stress couplings through cells, the shear couplings through edges), as 7-point

@@ -3,7 +3,9 @@
 // velocity, rigid translations cost nothing, and triangles beyond a wall are left out.
 
 #include "coupling/implicit_tension.h"
+#include "fluid/surface_preconditioner.h"
 #include "fluid/surface_viscosity.h"
+#include "fluid/viscosity.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/implicit_shape.h"
 #include "tracker/mesh_measures.h"
@@ -11,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <stdexcept>
 #include <vector>
 
@@ -94,6 +97,125 @@ TEST(ImplicitTension, TrianglesBeyondAWallAreLeftOut) {
     const Eigen::VectorXd row_sums = l * Eigen::VectorXd::Ones(l.cols());
     EXPECT_LT(row_sums.cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((Eigen::SparseMatrix<double>(l.transpose()) - l).norm(), 1e-12);
+}
+
+/// The viscous CG's Jacobi preconditioner with the surface term (fluid/surface_preconditioner.h)
+/// is the exact inverse of D + c Sᵀ (L ⊗ I₃) S: on a sphere's term with a stiffness c far above
+/// the diagonal (as past the capillary limit, over gas faces) it gives x back from
+/// (D + c SᵀLS) x, it is symmetric, and zero on fixed faces.
+TEST(ImplicitTension, SurfacePreconditionerInvertsTheDiagonalPlusTheSurfaceTermExactly) {
+    fluid::MacGrid grid(12, 12, 12, 1.0 / 12);
+    const tracker::SurfaceMesh mesh = sphere(Vector3d::Constant(0.5), 0.3, 0.06);
+    InterpolateOptions interpolate;
+    interpolate.method = VelocityInterpolation::trilinear;
+    const auto term = build_surface_viscosity(mesh, grid, 1.0, interpolate, {});
+    const std::size_t faces = static_cast<std::size_t>(term->sample.cols());
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+    std::vector<double> diagonal(faces), x(faces);
+    std::vector<char> unknown(faces, 1);
+    for (std::size_t f = 0; f < faces; ++f) {
+        diagonal[f] = 1.0 + 0.5 * uniform(random);  // gas-like faces: ρ ≈ 1
+        unknown[f] = f % 17 != 3;                   // some fixed faces among those sampled
+        x[f] = unknown[f] ? uniform(random) : 0.0;
+    }
+    const double c = 1e4;
+    fluid::SurfacePreconditioner preconditioner;
+    preconditioner.build(*term, c, diagonal, unknown);
+    ASSERT_TRUE(preconditioner.built());
+    std::vector<double> y(faces, 0.0);
+    term->add_stiffness(c, x, y);
+    double largest = 0.0;
+    for (std::size_t f = 0; f < faces; ++f) {
+        y[f] = unknown[f] ? y[f] + diagonal[f] * x[f] : 0.0;
+        largest = std::max(largest, std::abs(y[f]));
+    }
+    EXPECT_GT(largest, 100.0);  // the surface term dominates
+    std::vector<double> back;
+    preconditioner.apply(y, back);
+    double error = 0.0;
+    for (std::size_t f = 0; f < faces; ++f)
+        error = std::max(error, std::abs(back[f] - x[f]));
+    EXPECT_LT(error, 1e-8);  // of |x| ≤ 1, through a system of condition about c
+    // Symmetric: r₁ · M⁻¹ r₂ = r₂ · M⁻¹ r₁.
+    std::vector<double> r1(faces), r2(faces), z1, z2;
+    for (std::size_t f = 0; f < faces; ++f) {
+        r1[f] = unknown[f] ? uniform(random) : 0.0;
+        r2[f] = unknown[f] ? uniform(random) : 0.0;
+    }
+    preconditioner.apply(r1, z1);
+    preconditioner.apply(r2, z2);
+    EXPECT_NEAR(dot(r1, z2), dot(r2, z1), 1e-12 * std::abs(dot(r1, z2)));
+    for (std::size_t f = 0; f < faces; ++f) {
+        if (!unknown[f]) {
+            EXPECT_EQ(z1[f], 0.0);
+        }
+    }
+    // Sizes that do not fit are refused.
+    EXPECT_THROW(preconditioner.build(*term, c, std::vector<double>(faces - 1, 1.0), unknown),
+                 std::invalid_argument);
+}
+
+/// A gas bubble in water at 3.5 times the capillary step limit: the surface viscosity θσΔt is
+/// then far stiffer than the gas faces' mass. With the surface term in the Jacobi preconditioner
+/// the viscous CG converges in 19 iterations from a random field, where the plain diagonal took
+/// 66, to the answer hypre's PFMG V-cycles (which see the term only through its diagonal) reach
+/// in 66 as well.
+TEST(ImplicitTension, ViscousSolvePastTheCapillaryLimitConvergesInAFewIterations) {
+    const int n = 24;
+    const double dx = 1e-4;
+    fluid::MacGrid grid(n, n, n, dx);
+    const Vector3d centre = Vector3d::Constant(0.5 * n * dx);
+    const double radius = 0.3 * n * dx;
+    const tracker::SurfaceMesh mesh = sphere(centre, radius, dx);
+    fluid::InterfaceInput interface(grid);
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i)  // gas inside (φ > 0), water outside
+                interface.phi(i, j, k) = radius - (grid.cell_centre(i, j, k) - centre).norm();
+    fluid::PhaseOptions phases;  // water and air
+    phases.rho_liquid = 1000.0;
+    phases.rho_gas = 1.2;
+    phases.mu_liquid = 1e-3;
+    phases.mu_gas = 1.8e-5;
+    phases.sigma = 0.072;
+    const double rho_mean = 0.5 * (phases.rho_liquid + phases.rho_gas);
+    const double dt_capillary = std::sqrt(rho_mean * dx * dx * dx / (2.0 * M_PI * phases.sigma));
+    const double dt = 3.5 * dt_capillary;
+    InterpolateOptions interpolate;
+    interpolate.method = VelocityInterpolation::trilinear;
+    interface.surface_viscosity =
+        build_surface_viscosity(mesh, grid, phases.sigma * dt, interpolate, {});
+    // Random face velocities up to 0.1 m/s: every scale of wobble on the surface.
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> uniform(-0.1, 0.1);
+    for (int axis = 0; axis < 3; ++axis)
+        for (double& value : grid.velocity(axis).storage())
+            value = uniform(random);
+    const fluid::BoundaryOptions walls =
+        fluid::BoundaryOptions::all(fluid::BoundaryType::free_slip);
+    fluid::ViscosityOptions options;
+    options.iteration.tolerance = 1e-10;
+    fluid::MacGrid jacobi_grid = grid;
+    const fluid::SolveResult jacobi = fluid::apply_viscosity(
+        jacobi_grid, interface, phases, fluid::FluidMode::two_phase, walls, dt, options);
+    EXPECT_TRUE(jacobi.converged);
+    EXPECT_LE(jacobi.iterations, 20);
+    options.preconditioner = fluid::ViscousPreconditioner::hypre_pfmg;
+    options.iteration.max_iterations = 5000;
+    fluid::MacGrid pfmg_grid = grid;
+    const fluid::SolveResult pfmg = fluid::apply_viscosity(
+        pfmg_grid, interface, phases, fluid::FluidMode::two_phase, walls, dt, options);
+    EXPECT_TRUE(pfmg.converged);
+    EXPECT_GT(pfmg.iterations, 2 * jacobi.iterations);  // 66 against 19; plain Jacobi 66 too
+    double difference = 0.0;
+    for (int axis = 0; axis < 3; ++axis)
+        for (std::size_t f = 0; f < grid.velocity(axis).size(); ++f)
+            difference = std::max(difference, std::abs(jacobi_grid.velocity(axis).storage()[f] -
+                                                       pfmg_grid.velocity(axis).storage()[f]));
+    EXPECT_LT(difference, 1e-6);  // m/s, of speeds up to 0.1
+    std::printf("[ viscous CG ] surface Jacobi %d iterations, hypre PFMG %d\n", jacobi.iterations,
+                pfmg.iterations);
 }
 
 TEST(ImplicitTension, RefusesBadInputNamingIt) {
