@@ -1,5 +1,8 @@
 #include "coupling/implicit_tension.h"
 
+#include "fluid/interface_input.h"
+
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -10,14 +13,70 @@ namespace {
 
 using Eigen::Vector3d;
 using Triplet = Eigen::Triplet<double>;
+using RowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+/// ρ_f of the face at flat index `column` of [u | v | w]: ρ_g + (ρ_l − ρ_g) θ, θ the liquid
+/// fraction of the segment between its cells (a face on the box's boundary: its one cell's).
+double face_density(const fluid::MacGrid& grid, const fluid::Array3<double>& phi,
+                    std::size_t column, double rho_liquid, double rho_gas) {
+    int axis = 0;
+    while (column >= grid.velocity(axis).size()) {
+        column -= grid.velocity(axis).size();
+        ++axis;
+    }
+    const fluid::Array3<double>& faces = grid.velocity(axis);
+    const std::size_t ni = static_cast<std::size_t>(faces.ni());
+    const std::size_t nj = static_cast<std::size_t>(faces.nj());
+    std::array<int, 3> above = {static_cast<int>(column % ni), static_cast<int>((column / ni) % nj),
+                                static_cast<int>(column / (ni * nj))};
+    std::array<int, 3> below = above;
+    --below[static_cast<std::size_t>(axis)];
+    const int cells = axis == 0 ? grid.nx() : axis == 1 ? grid.ny() : grid.nz();
+    if (below[static_cast<std::size_t>(axis)] < 0)
+        below = above;
+    if (above[static_cast<std::size_t>(axis)] >= cells)
+        above = below;
+    const double theta = fluid::liquid_fraction(phi(below[0], below[1], below[2]),
+                                                phi(above[0], above[1], above[2]));
+    return rho_gas + (rho_liquid - rho_gas) * theta;
+}
+
+/// Scales each row of `sample` by the densities of the faces it reads and rescales it to its
+/// old sum (a row that reads only massless faces is left as it was).
+void weight_by_face_density(RowMatrix& sample, const fluid::MacGrid& grid,
+                            const fluid::Array3<double>& phi, double rho_liquid, double rho_gas) {
+    for (Eigen::Index row = 0; row < sample.outerSize(); ++row) {
+        double sum = 0.0, weighted = 0.0;
+        for (RowMatrix::InnerIterator it(sample, row); it; ++it) {
+            sum += it.value();
+            weighted += it.value() * face_density(grid, phi, static_cast<std::size_t>(it.col()),
+                                                  rho_liquid, rho_gas);
+        }
+        if (!(weighted > 0.0))
+            continue;
+        for (RowMatrix::InnerIterator it(sample, row); it; ++it)
+            it.valueRef() *=
+                face_density(grid, phi, static_cast<std::size_t>(it.col()), rho_liquid, rho_gas) *
+                sum / weighted;
+    }
+}
 
 }  // namespace
 
 std::shared_ptr<const fluid::SurfaceViscosity> build_surface_viscosity(
     const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid, double viscosity,
-    const InterpolateOptions& interpolate, const fluid::BoundaryOptions& walls) {
+    const InterpolateOptions& interpolate, const fluid::BoundaryOptions& walls,
+    const fluid::Array3<double>* phi, double rho_liquid, double rho_gas) {
     if (!(viscosity >= 0.0) || !std::isfinite(viscosity))
         throw std::invalid_argument("build_surface_viscosity: viscosity must be finite and >= 0");
+    if (phi) {
+        if (phi->ni() != grid.nx() || phi->nj() != grid.ny() || phi->nk() != grid.nz())
+            throw std::invalid_argument("build_surface_viscosity: phi must have the grid's cells");
+        if (!(rho_liquid > 0.0 && rho_gas >= 0.0) || !std::isfinite(rho_liquid) ||
+            !std::isfinite(rho_gas))
+            throw std::invalid_argument(
+                "build_surface_viscosity: rho_liquid must be > 0 and rho_gas >= 0");
+    }
     const Vector3d lo = grid.origin();
     const Vector3d hi = lo + grid.dx() * Vector3d(grid.nx(), grid.ny(), grid.nz());
     const auto inside = [&](const Vector3d& x) {
@@ -48,6 +107,8 @@ std::shared_ptr<const fluid::SurfaceViscosity> build_surface_viscosity(
     term->viscosity = viscosity;
     // The surface moves with the interpolated vertex velocities: the term must see them.
     term->sample = vertex_velocity_weights(grid, mesh, vertices, interpolate, walls);
+    if (phi)
+        weight_by_face_density(term->sample, grid, *phi, rho_liquid, rho_gas);
     std::vector<Triplet> entries;
     // Cotangent stiffness: each triangle adds ½ cot θ_i to the edge opposite its corner i.
     entries.reserve(triangles.size() * 12);

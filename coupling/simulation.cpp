@@ -174,10 +174,14 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     fluid::InterfaceInput interface;
     face_curvatures(grid_mesh, grid, raster, m_options.surface_tension, interface);
     interface.phi = std::move(raster.phi);
-    if (m_options.implicit_tension > 0.0 && phases.sigma > 0.0)
+    if (m_options.implicit_tension > 0.0 && phases.sigma > 0.0) {
+        // Sampled by face density (implicit_tension.h); free-surface gas faces carry no mass.
+        const bool two_phase = m_fluid.options().mode == fluid::FluidMode::two_phase;
         interface.surface_viscosity = build_surface_viscosity(
             mesh, grid, m_options.implicit_tension * phases.sigma * report.dt,
-            m_options.interpolate, m_fluid.options().boundaries);
+            m_options.interpolate, m_fluid.options().boundaries, &interface.phi, phases.rho_liquid,
+            two_phase ? phases.rho_gas : 0.0);
+    }
     clock.lap_into(timings.curvature);
 
     // (3) Fluid.

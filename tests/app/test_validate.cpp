@@ -392,12 +392,13 @@ TEST_F(QuickValidation, PartBCasesCarryConvergenceStudies) {
 }
 
 /// Semi-implicit surface tension at 3× the capillary limit against the explicit run, both with
-/// trilinear vertex velocities (issue 36 item 3): measured B4 ω −0.59 % (and its extra damping
-/// about ω²Δt/2: γ 0.79 against 0.06 1/s), B1 Δp −0.003 % with the peak spurious currents 5.3×
-/// the explicit run's (3.4e-2 against 6.3e-3 in max|u|·sqrt(ρD/σ)).
+/// trilinear vertex velocities (issue 36 item 3): measured B4 ω −0.56 % (and its extra damping
+/// about ω²Δt/2: γ 0.78 against 0.05 1/s), B2 ω −1.40 %, B1 Δp −0.003 % with the peak spurious
+/// currents 0.32× the explicit run's (2.9e-3 against 9.3e-3 in max|u|·sqrt(ρD/σ); 2.3× before
+/// the term's sampling was weighted by face density).
 TEST_F(QuickValidation, PartBImplicitTensionKeepsTheFrequencyAtThreeTimesTheCapillaryStep) {
     const Json& b = s_results["part_b"];
-    for (const char* id : {"B1", "B4"}) {
+    for (const char* id : {"B1", "B2", "B4"}) {
         SCOPED_TRACE(id);
         const Json& pair = b[id]["implicit_runs"];
         ASSERT_EQ(pair.size(), 2u);
@@ -416,8 +417,11 @@ TEST_F(QuickValidation, PartBImplicitTensionKeepsTheFrequencyAtThreeTimesTheCapi
               0.02);
     const Json& drop = b["B1"]["implicit_runs"];
     EXPECT_LT(std::abs(drop[1]["jump"].get<double>() / drop[0]["jump"].get<double>() - 1.0), 1e-3);
-    EXPECT_LT(drop[1]["capillary_number_peak"].get<double>(), B1_SPURIOUS_CAPILLARY_NUMBER);
-    EXPECT_TRUE(b["B2"]["implicit_runs"].empty());  // full mode only
+    EXPECT_LT(drop[1]["capillary_number_peak"].get<double>(),
+              drop[0]["capillary_number_peak"].get<double>());
+    const Json& lamb = b["B2"]["implicit_runs"];
+    EXPECT_LT(std::abs(lamb[1]["omega"].get<double>() / lamb[0]["omega"].get<double>() - 1.0),
+              0.02);
     EXPECT_NE(s_report.find("Semi-implicit surface tension"), std::string::npos);
 }
 

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -97,6 +98,68 @@ TEST(ImplicitTension, TrianglesBeyondAWallAreLeftOut) {
     const Eigen::VectorXd row_sums = l * Eigen::VectorXd::Ones(l.cols());
     EXPECT_LT(row_sums.cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((Eigen::SparseMatrix<double>(l.transpose()) - l).norm(), 1e-12);
+}
+
+TEST(ImplicitTension, SamplingWeightedByFaceDensityFollowsTheLiquid) {
+    // A water drop in air: the points read the faces around them weighted by their density.
+    fluid::MacGrid grid(16, 16, 16, 1.0 / 16);
+    const Vector3d centre = Vector3d::Constant(0.5);
+    const double radius = 0.3;
+    const tracker::SurfaceMesh mesh = sphere(centre, radius, 0.05);
+    fluid::Array3<double> phi(16, 16, 16, 0.0);
+    for (int k = 0; k < 16; ++k)
+        for (int j = 0; j < 16; ++j)
+            for (int i = 0; i < 16; ++i)
+                phi(i, j, k) = (grid.cell_centre(i, j, k) - centre).norm() - radius;
+    InterpolateOptions interpolate;
+    interpolate.method = VelocityInterpolation::trilinear;
+    const double rho_liquid = 1000.0, rho_gas = 1.2;
+    const auto plain = build_surface_viscosity(mesh, grid, 1.0, interpolate, {});
+    const auto weighted =
+        build_surface_viscosity(mesh, grid, 1.0, interpolate, {}, &phi, rho_liquid, rho_gas);
+    ASSERT_EQ(weighted->points(), plain->points());
+    // Each point's weights keep their sum (1: a uniform flow is read exactly, and costs no
+    // energy).
+    const Eigen::VectorXd ones = Eigen::VectorXd::Ones(weighted->sample.cols());
+    const Eigen::VectorXd sums = weighted->sample * ones;
+    EXPECT_LT((sums - plain->sample * ones).cwiseAbs().maxCoeff(), 1e-12);
+    const std::vector<double> shift =
+        linear_faces(grid, Vector3d(0.3, -0.2, 1.1), Eigen::Matrix3d::Zero());
+    std::vector<double> y(shift.size(), 0.0);
+    weighted->add_stiffness(1.0, shift, y);
+    for (double value : y)
+        EXPECT_LT(std::abs(value), 1e-12);
+    // A velocity on the all-gas faces alone (both cells in the air): the plain points read a
+    // good part of it, the weighted ones about ρ_g/ρ_l of it.
+    std::vector<double> gas(shift.size(), 0.0);
+    std::size_t flat = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const fluid::Array3<double>& faces = grid.velocity(axis);
+        for (int k = 0; k < faces.nk(); ++k)
+            for (int j = 0; j < faces.nj(); ++j)
+                for (int i = 0; i < faces.ni(); ++i, ++flat) {
+                    std::array<int, 3> lo = {i, j, k}, hi = {i, j, k};
+                    --lo[static_cast<std::size_t>(axis)];
+                    const bool inside = lo[static_cast<std::size_t>(axis)] >= 0 &&
+                                        hi[static_cast<std::size_t>(axis)] < 16;
+                    if (inside && phi(lo[0], lo[1], lo[2]) > 0.0 && phi(hi[0], hi[1], hi[2]) > 0.0)
+                        gas[flat] = 1.0;
+                }
+    }
+    const Eigen::Map<const Eigen::VectorXd> gas_faces(gas.data(),
+                                                      static_cast<Eigen::Index>(gas.size()));
+    const double plain_read = (plain->sample * gas_faces).maxCoeff();
+    const double weighted_read = (weighted->sample * gas_faces).maxCoeff();
+    EXPECT_GT(plain_read, 0.3);
+    EXPECT_LT(weighted_read, 0.01);
+    // φ must have the grid's cells, and the densities make sense.
+    fluid::Array3<double> small(8, 8, 8, 0.0);
+    EXPECT_THROW(build_surface_viscosity(mesh, grid, 1.0, interpolate, {}, &small, 1.0, 1.0),
+                 std::invalid_argument);
+    EXPECT_THROW(build_surface_viscosity(mesh, grid, 1.0, interpolate, {}, &phi, 0.0, 1.0),
+                 std::invalid_argument);
+    EXPECT_THROW(build_surface_viscosity(mesh, grid, 1.0, interpolate, {}, &phi, 1.0, -1.0),
+                 std::invalid_argument);
 }
 
 /// The viscous CG's Jacobi preconditioner with the surface term (fluid/surface_preconditioner.h)
