@@ -159,10 +159,13 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
     enum_field(v, "viscosity_preconditioner", o.viscosity.preconditioner,
                {{"multigrid", fluid::ViscousPreconditioner::multigrid},
                 {"jacobi", fluid::ViscousPreconditioner::jacobi},
+                {"jacobi_surface", fluid::ViscousPreconditioner::jacobi_surface},
                 {"hypre_pfmg", fluid::ViscousPreconditioner::hypre_pfmg}},
                "preconditioner of the viscous CG: a V-cycle per velocity component's block "
                "(`multigrid` our own, `hypre_pfmg` hypre's PFMG, which also runs on several "
-               "ranks), or the diagonal");
+               "ranks), the diagonal, or `jacobi_surface`: the diagonal plus "
+               "/coupling/implicit_tension's surface term, inverted exactly (3x fewer iterations "
+               "at 10x the capillary limit, but a sparse LU each step)");
     v.integer("viscosity_max_iterations", o.viscosity.iteration.max_iterations,
               Range::between(1, 100000), "", "CG iterations before a viscosity solve gives up");
     v.section("viscous_pressure", "how the viscous and pressure solves are coupled in a step",

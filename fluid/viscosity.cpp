@@ -30,6 +30,7 @@ void ViscosityOptions::validate() const {
         weights != ViscosityWeights::pointwise)
         throw std::invalid_argument("ViscosityOptions.weights: unknown weighting");
     if (preconditioner != ViscousPreconditioner::jacobi &&
+        preconditioner != ViscousPreconditioner::jacobi_surface &&
         preconditioner != ViscousPreconditioner::multigrid &&
         preconditioner != ViscousPreconditioner::hypre_pfmg)
         throw std::invalid_argument("ViscosityOptions.preconditioner: unknown preconditioner");
@@ -91,8 +92,8 @@ struct ViscositySolver::Workspace {
     std::array<PoissonMatrix, 3> blocks;
     std::array<std::unique_ptr<Preconditioner>, 3> cycles;
     ViscousPreconditioner cycles_kind = ViscousPreconditioner::jacobi;
-    /// jacobi with the implicit tension's surface term: the diagonal made exact for that term
-    /// (built on first use after `op`)
+    /// jacobi_surface with the implicit tension's surface term: the diagonal made exact for
+    /// that term (built on first use after `op`)
     SurfacePreconditioner surface_jacobi;
 
     void build_cycles(const ViscousOperator& op, bool distributed, const ViscosityOptions& options);
@@ -296,12 +297,13 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
             op.diagonal(ws.diagonal);
         const std::vector<double>& diagonal = ws.diagonal;
         const ViscousPreconditioner kind = options.preconditioner;
-        if (kind != ViscousPreconditioner::jacobi && (!ws.cycles[0] || ws.cycles_kind != kind))
+        const bool diagonal_kind =
+            kind == ViscousPreconditioner::jacobi || kind == ViscousPreconditioner::jacobi_surface;
+        if (!diagonal_kind && (!ws.cycles[0] || ws.cycles_kind != kind))
             ws.build_cycles(op, distributed, options);
-        // Past the capillary limit the surface term outweighs the gas faces' mass along the
-        // surface, which the diagonal alone leaves to hundreds of iterations: Jacobi then takes
-        // D + Sᵀ B S whole (surface_preconditioner.h).
-        const bool surface_jacobi = kind == ViscousPreconditioner::jacobi && surface;
+        // Far past the capillary limit the surface term outweighs the faces' mass along the
+        // surface: jacobi_surface takes D + Sᵀ B S whole (surface_preconditioner.h).
+        const bool surface_jacobi = kind == ViscousPreconditioner::jacobi_surface && surface;
         if (surface_jacobi && !ws.surface_jacobi.built()) {
             std::vector<double> grid_diagonal;
             op.diagonal(grid_diagonal, false);
@@ -316,7 +318,7 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
                 ws.surface_jacobi.apply(r, z);
                 return;
             }
-            if (kind == ViscousPreconditioner::jacobi) {
+            if (diagonal_kind) {
                 for (std::size_t f = 0; f < n; ++f)
                     z[f] = r[f] / diagonal[f];
                 return;
