@@ -34,9 +34,14 @@ void SurfaceViscosity::add_stiffness(double c, const std::vector<double>& x,
     const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> sp(
         s.data(), p, 3);
     Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> t = laplacian * sp;
-    const Eigen::Map<const Eigen::VectorXd> tv(t.data(), 3 * p);
-    Eigen::Map<Eigen::VectorXd> yv(y.data(), static_cast<Eigen::Index>(y.size()));
-    yv += c * (sample.transpose() * tv);
+    // y += c Sᵀ t, scattered row by row: Sᵀ t as an expression would build a dense temporary of
+    // all F faces (8 M entries at 128 cells, every CG iteration) to fill a few per point.
+    for (Eigen::Index row = 0; row < sample.outerSize(); ++row) {
+        const double scaled = c * t.data()[row];
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(sample, row); it;
+             ++it)
+            y[static_cast<std::size_t>(it.col())] += scaled * it.value();
+    }
 }
 
 void SurfaceViscosity::add_diagonal_bound(double c, std::vector<double>& d) const {
