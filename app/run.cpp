@@ -27,6 +27,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -339,6 +340,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
         long long steps = 0;
         FluidFrameTimes times;
         long long intersecting = -1, merges = 0, splits = 0, shortenings = 0;
+        std::map<std::string, long long> limits;  // steps per limit that set their Δt
         FrameSolves solves;
         FrameOpenBoundaries open_faces;
         while (t < t_frame) {
@@ -354,6 +356,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
             merges += last.volume.merges;
             splits += last.volume.splits;
             shortenings += last.integrate.collisions.step_shortenings;
+            ++limits[coupling::to_string(last.limit)];
             t = (t_frame - (t + last.dt) <= 1e-12 * t_frame) ? t_frame : t + last.dt;
             ++steps;
             ++result.steps;
@@ -367,6 +370,7 @@ static void run_fluid_scene(const Scene& scene, const RunOptions& options,
                                {"merges", merges},
                                {"splits", splits},
                                {"step_shortenings", shortenings},
+                               {"dt_limits", limits},
                                {"solves", solves.json(steps)}};
         const fluid::BoundaryOptions& boundaries = sim.fluid().options().boundaries;
         if (boundaries.open() || boundaries.inflow())

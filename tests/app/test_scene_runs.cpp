@@ -220,6 +220,14 @@ TEST(FluidScenes, TimeDtCapsTheFluidStep) {
     ASSERT_EQ(capped.size(), 2u);
     EXPECT_LE(capped[1]["dt"].get<double>(), cap * (1.0 + 1e-12));
     EXPECT_GE(capped[1]["steps"].get<long long>(), static_cast<long long>(frame / cap));
+    // dt_limits counts the frame's steps by what set their Δt: here the cap, and the last step
+    // at most the frame's end.
+    const nlohmann::json& limits = capped[1]["dt_limits"];
+    long long counted = 0;
+    for (const auto& [limit, steps] : limits.items())
+        counted += steps.get<long long>();
+    EXPECT_EQ(counted, capped[1]["steps"].get<long long>());
+    EXPECT_GE(limits.value("max_dt", 0LL), capped[1]["steps"].get<long long>() - 1);
 }
 
 TEST(FluidScenes, StatsReportTheViscousAndPressureSolves) {
