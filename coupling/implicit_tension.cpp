@@ -45,19 +45,21 @@ double face_density(const fluid::MacGrid& grid, const fluid::Array3<double>& phi
 /// old sum (a row that reads only massless faces is left as it was).
 void weight_by_face_density(RowMatrix& sample, const fluid::MacGrid& grid,
                             const fluid::Array3<double>& phi, double rho_liquid, double rho_gas) {
+    std::vector<double> density;  // of the row's faces, in the row's order
     for (Eigen::Index row = 0; row < sample.outerSize(); ++row) {
         double sum = 0.0, weighted = 0.0;
+        density.clear();
         for (RowMatrix::InnerIterator it(sample, row); it; ++it) {
+            density.push_back(face_density(grid, phi, static_cast<std::size_t>(it.col()),
+                                           rho_liquid, rho_gas));
             sum += it.value();
-            weighted += it.value() * face_density(grid, phi, static_cast<std::size_t>(it.col()),
-                                                  rho_liquid, rho_gas);
+            weighted += it.value() * density.back();
         }
         if (!(weighted > 0.0))
             continue;
+        std::size_t entry = 0;
         for (RowMatrix::InnerIterator it(sample, row); it; ++it)
-            it.valueRef() *=
-                face_density(grid, phi, static_cast<std::size_t>(it.col()), rho_liquid, rho_gas) *
-                sum / weighted;
+            it.valueRef() *= density[entry++] * sum / weighted;
     }
 }
 

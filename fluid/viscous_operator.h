@@ -56,8 +56,7 @@ public:
     /// SurfacePreconditioner, which takes that term whole).
     void diagonal(std::vector<double>& d, bool with_surface = true) const;
 
-    /// The implicit tension's term and its scale Δt μ_s / Δx³ in K (null when there is none).
-    const SurfaceViscosity* surface() const { return m_surface; }
+    /// The scale Δt μ_s / Δx³ of the implicit tension's term in K (0 when there is none).
     double surface_scale() const { return m_surface_scale; }
 
     /// The diagonal blocks of ρ + K, each velocity component coupled with itself alone (the
