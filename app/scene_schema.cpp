@@ -236,6 +236,13 @@ void visit_fields(V& v, CouplingOptions& o) {
              "surface's tension is taken, a surface viscosity θσΔt in the viscous solve (0 = "
              "explicit; 1 is the validated value, 0.5 went unstable at 3× the limit); needs "
              "velocity_interpolation trilinear");
+    enum_field(
+        v, "implicit_tension_form", o.simulation.implicit_tension_form,
+        {{"normal", coupling::SurfaceTermForm::normal}, {"full", coupling::SurfaceTermForm::full}},
+        "the implicit term's surface stiffness: normal (damps the velocity's normal "
+        "component's gradient: shape changes only) or full (Hysing's, all three components: "
+        "it damps the surface's stretching too, which keeps films between bubbles from "
+        "draining)");
 }
 
 template <typename V>

@@ -68,9 +68,11 @@ void weight_by_face_density(RowMatrix& sample, const fluid::MacGrid& grid,
 std::shared_ptr<const fluid::SurfaceViscosity> build_surface_viscosity(
     const tracker::SurfaceMesh& mesh, const fluid::MacGrid& grid, double viscosity,
     const InterpolateOptions& interpolate, const fluid::BoundaryOptions& walls,
-    const fluid::Array3<double>* phi, double rho_liquid, double rho_gas) {
+    const fluid::Array3<double>* phi, double rho_liquid, double rho_gas, SurfaceTermForm form) {
     if (!(viscosity >= 0.0) || !std::isfinite(viscosity))
         throw std::invalid_argument("build_surface_viscosity: viscosity must be finite and >= 0");
+    if (form != SurfaceTermForm::normal && form != SurfaceTermForm::full)
+        throw std::invalid_argument("build_surface_viscosity: unknown form");
     if (phi) {
         if (phi->ni() != grid.nx() || phi->nj() != grid.ny() || phi->nk() != grid.nz())
             throw std::invalid_argument("build_surface_viscosity: phi must have the grid's cells");
@@ -111,11 +113,28 @@ std::shared_ptr<const fluid::SurfaceViscosity> build_surface_viscosity(
     term->sample = vertex_velocity_weights(grid, mesh, vertices, interpolate, walls);
     if (phi)
         weight_by_face_density(term->sample, grid, *phi, rho_liquid, rho_gas);
+    // Cotangent stiffness: each triangle adds ½ cot θ_i to the edge opposite its corner i, as the
+    // 3 × 3 block I₃ (full) or n_T n_Tᵀ (normal) on the two points' velocities.
     std::vector<Triplet> entries;
-    // Cotangent stiffness: each triangle adds ½ cot θ_i to the edge opposite its corner i.
-    entries.reserve(triangles.size() * 12);
+    entries.reserve(triangles.size() * 3 * 4 * (form == SurfaceTermForm::full ? 3 : 9));
+    const auto add_block = [&](Eigen::Index p, Eigen::Index q, double w, const Vector3d& n) {
+        for (Eigen::Index a = 0; a < 3; ++a) {
+            if (form == SurfaceTermForm::full) {
+                entries.emplace_back(3 * p + a, 3 * q + a, w);
+                continue;
+            }
+            for (Eigen::Index b = 0; b < 3; ++b)
+                entries.emplace_back(3 * p + a, 3 * q + b, w * n[a] * n[b]);
+        }
+    };
     for (int t : triangles) {
         const tracker::Triangle& tri = mesh.triangle(t);
+        const Vector3d area_normal = (mesh.position(tri[1]) - mesh.position(tri[0]))
+                                         .cross(mesh.position(tri[2]) - mesh.position(tri[0]));
+        const double twice_area = area_normal.norm();
+        if (!(twice_area > 0.0))
+            continue;  // degenerate: no gradient to penalise, no normal
+        const Vector3d n = area_normal / twice_area;
         for (int c = 0; c < 3; ++c) {
             const int i = tri[static_cast<size_t>(c)];
             const int j = tri[static_cast<size_t>((c + 1) % 3)];
@@ -124,18 +143,18 @@ std::shared_ptr<const fluid::SurfaceViscosity> build_surface_viscosity(
             const Vector3d b = mesh.position(k) - mesh.position(i);
             const double sine = a.cross(b).norm();
             if (!(sine > 1e-12 * a.norm() * b.norm()))
-                continue;  // a degenerate corner: no gradient to penalise, cot unbounded
+                continue;  // a degenerate corner: cot unbounded
             const double w = 0.5 * a.dot(b) / sine;
             const Eigen::Index pj = point[static_cast<size_t>(j)];
             const Eigen::Index pk = point[static_cast<size_t>(k)];
-            entries.emplace_back(pj, pk, -w);
-            entries.emplace_back(pk, pj, -w);
-            entries.emplace_back(pj, pj, w);
-            entries.emplace_back(pk, pk, w);
+            add_block(pj, pk, -w, n);
+            add_block(pk, pj, -w, n);
+            add_block(pj, pj, w, n);
+            add_block(pk, pk, w, n);
         }
     }
-    term->laplacian.resize(points, points);
-    term->laplacian.setFromTriplets(entries.begin(), entries.end());
+    term->stiffness.resize(3 * points, 3 * points);
+    term->stiffness.setFromTriplets(entries.begin(), entries.end());
     return term;
 }
 

@@ -70,6 +70,9 @@ void SimulationOptions::validate() const {
     open_boundaries.validate();
     if (!(implicit_tension >= 0.0 && implicit_tension <= 1.0))
         throw std::invalid_argument("implicit_tension: expected a number in [0, 1]");
+    if (implicit_tension_form != SurfaceTermForm::normal &&
+        implicit_tension_form != SurfaceTermForm::full)
+        throw std::invalid_argument("implicit_tension_form: expected normal or full");
     if (implicit_tension > 0.0 && interpolate.method != VelocityInterpolation::trilinear)
         throw std::invalid_argument(
             "implicit_tension: needs the trilinear vertex velocities (velocity_interpolation "
@@ -180,7 +183,7 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
         interface.surface_viscosity = build_surface_viscosity(
             mesh, grid, m_options.implicit_tension * phases.sigma * report.dt,
             m_options.interpolate, m_fluid.options().boundaries, &interface.phi, phases.rho_liquid,
-            two_phase ? phases.rho_gas : 0.0);
+            two_phase ? phases.rho_gas : 0.0, m_options.implicit_tension_form);
     }
     clock.lap_into(timings.curvature);
 

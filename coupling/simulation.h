@@ -10,6 +10,7 @@
 /// entered and left (open_boundaries.h).
 
 #include "common/phase_clock.h"
+#include "coupling/implicit_tension.h"
 #include "coupling/interpolate.h"
 #include "coupling/open_boundaries.h"
 #include "coupling/rasterize.h"
@@ -54,6 +55,10 @@ struct SimulationOptions {
     /// the one-sided method or trilinearly (max|u| 0.063 and 0.038 m/s against the explicit
     /// run's 0.024); with trilinear ones it stays within the explicit run's 0.025 for 25 ms.
     double implicit_tension = 0.0;
+    /// Which surface stiffness the implicit term uses (implicit_tension.h): `normal` (only
+    /// shape-changing motion is damped) or Hysing's `full` (the surface's stretching too, which
+    /// immobilised bubble_merge's interfaces: its film did not drain).
+    SurfaceTermForm implicit_tension_form = SurfaceTermForm::normal;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
 

@@ -2,8 +2,6 @@
 
 #include "fluid/surface_viscosity.h"
 
-#include <tbb/parallel_for.h>
-
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -31,26 +29,17 @@ void SurfacePreconditioner::build(const SurfaceViscosity& surface, double scale,
                                         std::to_string(f) + " is not positive");
         inverse[f] = 1.0 / d;
     }
-    const Eigen::Index points = surface.points();
-    m_stiffness = scale * surface.laplacian;
-    const auto build_component = [&](std::size_t a) {
-        // The rows 3p + a of S, with the fixed faces' columns kept (D⁻¹ is 0 there).
-        std::vector<Eigen::Triplet<double>> entries;
-        for (Eigen::Index p = 0; p < points; ++p)
-            for (RowMatrix::InnerIterator it(surface.sample, 3 * p + static_cast<Eigen::Index>(a));
-                 it; ++it)
-                entries.emplace_back(static_cast<int>(p), static_cast<int>(it.col()), it.value());
-        RowMatrix& sample = m_sample[a];
-        sample.resize(points, faces);
-        sample.setFromTriplets(entries.begin(), entries.end());
-        m_system[a].reset();
-        if (points == 0)
-            return;
-        const RowMatrix scaled = sample * inverse.asDiagonal();
-        const ColumnMatrix gram = scaled * sample.transpose();  // G = S D⁻¹ Sᵀ
+    m_system.reset();
+    m_stiffness = scale * surface.stiffness;
+    if (surface.points() > 0) {
+        // S keeps the fixed faces' columns (D⁻¹ is 0 there). G = S D⁻¹ Sᵀ is block diagonal by
+        // component (a row of S reads one component's faces); B G couples them only where the
+        // normal form's K does.
+        const RowMatrix scaled = surface.sample * inverse.asDiagonal();
+        const ColumnMatrix gram = scaled * surface.sample.transpose();
         ColumnMatrix system = m_stiffness * gram;
-        for (Eigen::Index p = 0; p < points; ++p)
-            system.coeffRef(p, p) += 1.0;
+        for (Eigen::Index r = 0; r < system.rows(); ++r)
+            system.coeffRef(r, r) += 1.0;
         system.makeCompressed();
         auto lu = std::make_unique<Eigen::SparseLU<ColumnMatrix>>();
         lu->compute(system);
@@ -58,9 +47,9 @@ void SurfacePreconditioner::build(const SurfaceViscosity& surface, double scale,
             throw std::invalid_argument(
                 "SurfacePreconditioner: the surface system's factorisation failed (" +
                 lu->lastErrorMessage() + ")");
-        m_system[a] = std::move(lu);
-    };
-    tbb::parallel_for(std::size_t{0}, std::size_t{3}, build_component);
+        m_system = std::move(lu);
+        m_sample = surface.sample;
+    }
     m_inverse_diagonal = std::move(inverse);
 }
 
@@ -74,18 +63,14 @@ void SurfacePreconditioner::apply(const std::vector<double>& r, std::vector<doub
     const Eigen::Map<const Eigen::VectorXd> rv(r.data(), faces);
     Eigen::Map<Eigen::VectorXd> zv(z.data(), faces);
     zv = m_inverse_diagonal.cwiseProduct(rv);  // D⁻¹ r
-    // Each component's correction reads z = D⁻¹ r on its own faces and writes there only, so
-    // the three run side by side on z.
-    tbb::parallel_for(std::size_t{0}, std::size_t{3}, [&](std::size_t a) {
-        if (!m_system[a])
-            return;
-        const RowMatrix& sample = m_sample[a];
-        const Eigen::VectorXd sampled = sample * zv;  // S D⁻¹ r
-        const Eigen::VectorXd solved = m_system[a]->solve(m_stiffness * sampled);
-        for (Eigen::Index p = 0; p < sample.outerSize(); ++p)  // z −= D⁻¹ Sᵀ (I + B G)⁻¹ B S D⁻¹ r
-            for (RowMatrix::InnerIterator it(sample, p); it; ++it)
-                zv[it.col()] -= m_inverse_diagonal[it.col()] * it.value() * solved[p];
-    });
+    if (!m_system)
+        return;
+    const Eigen::VectorXd sampled = m_sample * zv;  // S D⁻¹ r
+    const Eigen::VectorXd solved = m_system->solve(m_stiffness * sampled);
+    for (Eigen::Index row = 0; row < m_sample.outerSize();
+         ++row)  // z −= D⁻¹ Sᵀ (I + B G)⁻¹ B S D⁻¹ r
+        for (RowMatrix::InnerIterator it(m_sample, row); it; ++it)
+            zv[it.col()] -= m_inverse_diagonal[it.col()] * it.value() * solved[row];
 }
 
 }  // namespace meniscus::fluid

@@ -3,8 +3,8 @@
 /// term (surface_viscosity.h).
 ///
 /// With the surface viscosity the viscous operator is A = D + R + Sᵀ B S: D its grid part's
-/// diagonal, R the grid part's off-diagonal couplings, B = c (L ⊗ I₃) the surface stiffness on
-/// the sampled point velocities (c = Δt μ_s / Δx³). Past the capillary limit the surface term
+/// diagonal, R the grid part's off-diagonal couplings, B = c K the surface stiffness on the
+/// sampled point velocities (c = Δt μ_s / Δx³). Past the capillary limit the surface term
 /// can outweigh the faces' mass by far, and only along the surface: with the term sampled
 /// trilinearly (gas faces and all) the plain diagonal left bubble_merge's coupled step at 3× the
 /// limit with 300 iterations, against 76 with this preconditioner; sampled by face density, as
@@ -13,8 +13,9 @@
 ///
 ///   M⁻¹ = D⁻¹ − D⁻¹ Sᵀ (I + B G)⁻¹ B S D⁻¹,  G = S D⁻¹ Sᵀ,
 ///
-/// a P × P system per velocity component (S's rows for component a sample only a's faces, so G
-/// and B are block diagonal by component), factorised once per operator with a sparse LU.
+/// a 3P × 3P sparse system (G is block diagonal by component, since a row of S samples one
+/// component's faces; K couples the components only in its normal form), factorised once per
+/// operator with a sparse LU.
 /// I + B G is invertible (B G ~ G^½ B G^½ ⪰ 0), and M⁻¹ is symmetric positive definite, being
 /// the inverse of D + Sᵀ B S. Where R is small beside D (water and air: ρ/Δt ≫ μ/Δx²), M⁻¹ is
 /// close to A⁻¹ itself.
@@ -23,7 +24,6 @@
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
 
-#include <array>
 #include <memory>
 #include <vector>
 
@@ -50,10 +50,10 @@ private:
     using RowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
     using ColumnMatrix = Eigen::SparseMatrix<double>;
     Eigen::VectorXd m_inverse_diagonal;  ///< D⁻¹, 0 on fixed faces
-    std::array<RowMatrix, 3> m_sample;   ///< S_a: the rows of component a (P × F)
-    ColumnMatrix m_stiffness;            ///< B per component: c L (P × P)
-    /// I + B G_a, factorised (a null pointer when there are no points)
-    std::array<std::unique_ptr<Eigen::SparseLU<ColumnMatrix>>, 3> m_system;
+    RowMatrix m_sample;                  ///< S (3P × F)
+    ColumnMatrix m_stiffness;            ///< B = c K (3P × 3P)
+    /// I + B G, factorised (a null pointer when there are no points)
+    std::unique_ptr<Eigen::SparseLU<ColumnMatrix>> m_system;
 };
 
 }  // namespace meniscus::fluid

@@ -11,11 +11,12 @@ namespace meniscus::fluid {
 void SurfaceViscosity::validate(const MacGrid& grid) const {
     const std::ptrdiff_t faces = static_cast<std::ptrdiff_t>(
         grid.u().size() + grid.v().size() + grid.w().size());
-    if (laplacian.rows() != laplacian.cols())
-        throw std::invalid_argument("SurfaceViscosity.laplacian must be square");
-    if (sample.rows() != 3 * laplacian.rows())
-        throw std::invalid_argument("SurfaceViscosity.sample must have 3 rows per surface point (" +
-                                    std::to_string(3 * laplacian.rows()) + ")");
+    if (stiffness.rows() != stiffness.cols() || stiffness.rows() % 3 != 0)
+        throw std::invalid_argument(
+            "SurfaceViscosity.stiffness must be square with 3 rows per surface point");
+    if (sample.rows() != stiffness.rows())
+        throw std::invalid_argument("SurfaceViscosity.sample must have the stiffness's " +
+                                    std::to_string(stiffness.rows()) + " rows");
     if (sample.cols() != faces)
         throw std::invalid_argument("SurfaceViscosity.sample must have one column per face (" +
                                     std::to_string(faces) + ")");
@@ -29,15 +30,13 @@ void SurfaceViscosity::add_stiffness(double c, const std::vector<double>& x,
     if (p == 0 || c == 0.0)
         return;
     const Eigen::Map<const Eigen::VectorXd> xv(x.data(), static_cast<Eigen::Index>(x.size()));
-    // s = S x as a P × 3 matrix (row p: the velocity at point p), t = L s column by column.
+    // s = S x (the point velocities), t = K s.
     const Eigen::VectorXd s = sample * xv;
-    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> sp(
-        s.data(), p, 3);
-    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> t = laplacian * sp;
+    const Eigen::VectorXd t = stiffness * s;
     // y += c Sᵀ t, scattered row by row: Sᵀ t as an expression would build a dense temporary of
     // all F faces (8 M entries at 128 cells, every CG iteration) to fill a few per point.
     for (Eigen::Index row = 0; row < sample.outerSize(); ++row) {
-        const double scaled = c * t.data()[row];
+        const double scaled = c * t[row];
         for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(sample, row); it;
              ++it)
             y[static_cast<std::size_t>(it.col())] += scaled * it.value();
@@ -47,9 +46,9 @@ void SurfaceViscosity::add_stiffness(double c, const std::vector<double>& x,
 void SurfaceViscosity::add_diagonal_bound(double c, std::vector<double>& d) const {
     if (points() == 0 || c == 0.0)
         return;
-    const Eigen::VectorXd diagonal = laplacian.diagonal();
+    const Eigen::VectorXd diagonal = stiffness.diagonal();
     for (Eigen::Index row = 0; row < sample.outerSize(); ++row) {
-        const double l = diagonal[row / 3];
+        const double l = diagonal[row];
         for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(sample, row); it;
              ++it)
             d[static_cast<std::size_t>(it.col())] += c * l * it.value() * it.value();

@@ -58,10 +58,11 @@ TEST(ImplicitTension, EnergyOfTheIdentityFieldIsTwiceTheAreaAndTranslationsAreFr
          {VelocityInterpolation::trilinear, VelocityInterpolation::one_sided}) {
         InterpolateOptions options;
         options.method = method;
-        const auto term = build_surface_viscosity(mesh, grid, 2.0, options, {});
+        const auto term = build_surface_viscosity(mesh, grid, 2.0, options, {}, nullptr, 1.0, 1.0,
+                                                  SurfaceTermForm::full);
         EXPECT_EQ(term->points(), mesh.count_live_vertices());
-        // u = x: every interpolation is exact for linear fields, and the cotangent energy of
-        // the identity on a piecewise-linear surface is ∫ tr(P_Γ) dA = 2 · area exactly.
+        // u = x: every interpolation is exact for linear fields, and the full form's cotangent
+        // energy of the identity on a piecewise-linear surface is ∫ tr(P_Γ) dA = 2 · area exactly.
         const std::vector<double> identity =
             linear_faces(grid, Vector3d::Zero(), Eigen::Matrix3d::Identity());
         std::vector<double> y(identity.size(), 0.0);
@@ -86,6 +87,79 @@ TEST(ImplicitTension, EnergyOfTheIdentityFieldIsTwiceTheAreaAndTranslationsAreFr
     }
 }
 
+/// A flat square patch (z = 0.5, 0.2 ≤ x, y ≤ 0.8) in a unit box, split into right triangles.
+tracker::SurfaceMesh flat_patch(int cells) {
+    std::vector<tracker::Vec3> positions;
+    std::vector<tracker::Triangle> triangles;
+    const double h = 0.6 / cells;
+    for (int j = 0; j <= cells; ++j)
+        for (int i = 0; i <= cells; ++i)
+            positions.emplace_back(0.2 + i * h, 0.2 + j * h, 0.5);
+    const auto at = [&](int i, int j) { return j * (cells + 1) + i; };
+    for (int j = 0; j < cells; ++j)
+        for (int i = 0; i < cells; ++i) {
+            triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+            triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+    return tracker::SurfaceMesh(positions, triangles);
+}
+
+double energy(const fluid::SurfaceViscosity& term, const std::vector<double>& faces) {
+    std::vector<double> y(faces.size(), 0.0);
+    term.add_stiffness(1.0, faces, y);
+    return dot(faces, y);
+}
+
+/// The normal form damps only what changes the surface's shape. On a flat patch (area A = 0.36)
+/// stretched along itself (u = (x, y, 0), a film draining outwards) its energy is 0 where the
+/// full form's is 2A; a normal velocity growing along the patch (u = (0, 0, x)) costs A in both
+/// forms. On a sphere, translations and the uniform dilation u = x − c (which changes the
+/// curvature only through the |II|² term that Hysing's form leaves out as well) are free. The
+/// drop's n = 2 mode u = M(x − c), M = diag(1, 1, −2), costs ∫ |Mn|² − (nᵀMn)² dA = 1.2 A in the
+/// normal form (n_T fixed in each triangle) against ∫ tr M² − |Mn|² dA = 4 A in the full one: the
+/// normal form sees the mode's normal part and lets its tangential part go.
+TEST(ImplicitTension, NormalFormLeavesTheSurfacesStretchingFree) {
+    fluid::MacGrid grid(16, 16, 16, 1.0 / 16);
+    InterpolateOptions interpolate;
+    interpolate.method = VelocityInterpolation::trilinear;
+    const auto build = [&](const tracker::SurfaceMesh& mesh, SurfaceTermForm form) {
+        return build_surface_viscosity(mesh, grid, 1.0, interpolate, {}, nullptr, 1.0, 1.0, form);
+    };
+    const tracker::SurfaceMesh patch = flat_patch(12);
+    const double area = 0.36;
+    const auto normal = build(patch, SurfaceTermForm::normal);
+    const auto full = build(patch, SurfaceTermForm::full);
+    Eigen::Matrix3d stretch = Eigen::Matrix3d::Zero();
+    stretch(0, 0) = stretch(1, 1) = 1.0;
+    const std::vector<double> draining = linear_faces(grid, Vector3d(-0.5, -0.5, 0.0), stretch);
+    EXPECT_NEAR(energy(*normal, draining), 0.0, 1e-12);
+    EXPECT_NEAR(energy(*full, draining), 2.0 * area, 1e-10);
+    Eigen::Matrix3d tilt = Eigen::Matrix3d::Zero();
+    tilt(2, 0) = 1.0;
+    const std::vector<double> tilting = linear_faces(grid, Vector3d::Zero(), tilt);
+    EXPECT_NEAR(energy(*normal, tilting), area, 1e-10);
+    EXPECT_NEAR(energy(*full, tilting), area, 1e-10);
+
+    const Vector3d centre = Vector3d::Constant(0.5);
+    const tracker::SurfaceMesh ball = sphere(centre, 0.3, 0.05);
+    const auto on_ball = build(ball, SurfaceTermForm::normal);
+    const auto on_ball_full = build(ball, SurfaceTermForm::full);
+    const double ball_area = tracker::surface_area(ball);
+    EXPECT_NEAR(
+        energy(*on_ball, linear_faces(grid, Vector3d(0.3, -0.2, 1.1), Eigen::Matrix3d::Zero())),
+        0.0, 1e-12);
+    EXPECT_NEAR(energy(*on_ball, linear_faces(grid, -centre, Eigen::Matrix3d::Identity())), 0.0,
+                1e-12 * ball_area);
+    const Eigen::Matrix3d mode = Eigen::Vector3d(1.0, 1.0, -2.0).asDiagonal();
+    const std::vector<double> wobble = linear_faces(grid, -mode * centre, mode);
+    const double normal_energy = energy(*on_ball, wobble);
+    const double full_energy = energy(*on_ball_full, wobble);
+    EXPECT_NEAR(normal_energy / ball_area, 1.2, 0.06);
+    EXPECT_NEAR(full_energy / ball_area, 4.0, 0.2);
+    std::printf("[ n = 2 mode ] energy: normal form %.4g, full form %.4g\n", normal_energy,
+                full_energy);
+}
+
 TEST(ImplicitTension, TrianglesBeyondAWallAreLeftOut) {
     // A sphere sticking out of the box's top: only the triangles wholly inside are in L.
     fluid::MacGrid grid(16, 16, 16, 1.0 / 16);
@@ -93,8 +167,8 @@ TEST(ImplicitTension, TrianglesBeyondAWallAreLeftOut) {
     const auto term = build_surface_viscosity(mesh, grid, 1.0, {}, {});
     EXPECT_GT(term->points(), 0);
     EXPECT_LT(term->points(), mesh.count_live_vertices());
-    // Each row of L sums to zero (constants are in its null space) and L is symmetric.
-    const Eigen::SparseMatrix<double> l = term->laplacian;
+    // Each row of K sums to zero (translations are in its null space) and K is symmetric.
+    const Eigen::SparseMatrix<double> l = term->stiffness;
     const Eigen::VectorXd row_sums = l * Eigen::VectorXd::Ones(l.cols());
     EXPECT_LT(row_sums.cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((Eigen::SparseMatrix<double>(l.transpose()) - l).norm(), 1e-12);
@@ -163,67 +237,72 @@ TEST(ImplicitTension, SamplingWeightedByFaceDensityFollowsTheLiquid) {
 }
 
 /// The viscous CG's Jacobi preconditioner with the surface term (fluid/surface_preconditioner.h)
-/// is the exact inverse of D + c Sᵀ (L ⊗ I₃) S: on a sphere's term with a stiffness c far above
-/// the diagonal (as past the capillary limit, over gas faces) it gives x back from
-/// (D + c SᵀLS) x, it is symmetric, and zero on fixed faces.
+/// is the exact inverse of D + c Sᵀ K S, in either form: on a sphere's term with a stiffness c far
+/// above the diagonal (as past the capillary limit, over gas faces) it gives x back from (D + c
+/// SᵀLS) x, it is symmetric, and zero on fixed faces.
 TEST(ImplicitTension, SurfacePreconditionerInvertsTheDiagonalPlusTheSurfaceTermExactly) {
     fluid::MacGrid grid(12, 12, 12, 1.0 / 12);
     const tracker::SurfaceMesh mesh = sphere(Vector3d::Constant(0.5), 0.3, 0.06);
     InterpolateOptions interpolate;
     interpolate.method = VelocityInterpolation::trilinear;
-    const auto term = build_surface_viscosity(mesh, grid, 1.0, interpolate, {});
-    const std::size_t faces = static_cast<std::size_t>(term->sample.cols());
-    std::mt19937 random(7);
-    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-    std::vector<double> diagonal(faces), x(faces);
-    std::vector<char> unknown(faces, 1);
-    for (std::size_t f = 0; f < faces; ++f) {
-        diagonal[f] = 1.0 + 0.5 * uniform(random);  // gas-like faces: ρ ≈ 1
-        unknown[f] = f % 17 != 3;                   // some fixed faces among those sampled
-        x[f] = unknown[f] ? uniform(random) : 0.0;
-    }
-    const double c = 1e4;
-    fluid::SurfacePreconditioner preconditioner;
-    preconditioner.build(*term, c, diagonal, unknown);
-    ASSERT_TRUE(preconditioner.built());
-    std::vector<double> y(faces, 0.0);
-    term->add_stiffness(c, x, y);
-    double largest = 0.0;
-    for (std::size_t f = 0; f < faces; ++f) {
-        y[f] = unknown[f] ? y[f] + diagonal[f] * x[f] : 0.0;
-        largest = std::max(largest, std::abs(y[f]));
-    }
-    EXPECT_GT(largest, 100.0);  // the surface term dominates
-    std::vector<double> back;
-    preconditioner.apply(y, back);
-    double error = 0.0;
-    for (std::size_t f = 0; f < faces; ++f)
-        error = std::max(error, std::abs(back[f] - x[f]));
-    EXPECT_LT(error, 1e-8);  // of |x| ≤ 1, through a system of condition about c
-    // Symmetric: r₁ · M⁻¹ r₂ = r₂ · M⁻¹ r₁.
-    std::vector<double> r1(faces), r2(faces), z1, z2;
-    for (std::size_t f = 0; f < faces; ++f) {
-        r1[f] = unknown[f] ? uniform(random) : 0.0;
-        r2[f] = unknown[f] ? uniform(random) : 0.0;
-    }
-    preconditioner.apply(r1, z1);
-    preconditioner.apply(r2, z2);
-    EXPECT_NEAR(dot(r1, z2), dot(r2, z1), 1e-12 * std::abs(dot(r1, z2)));
-    for (std::size_t f = 0; f < faces; ++f) {
-        if (!unknown[f]) {
-            EXPECT_EQ(z1[f], 0.0);
+    for (SurfaceTermForm form : {SurfaceTermForm::normal, SurfaceTermForm::full}) {
+        SCOPED_TRACE(form == SurfaceTermForm::normal ? "normal form" : "full form");
+        const auto term =
+            build_surface_viscosity(mesh, grid, 1.0, interpolate, {}, nullptr, 1.0, 1.0, form);
+        const std::size_t faces = static_cast<std::size_t>(term->sample.cols());
+        std::mt19937 random(7);
+        std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+        std::vector<double> diagonal(faces), x(faces);
+        std::vector<char> unknown(faces, 1);
+        for (std::size_t f = 0; f < faces; ++f) {
+            diagonal[f] = 1.0 + 0.5 * uniform(random);  // gas-like faces: ρ ≈ 1
+            unknown[f] = f % 17 != 3;                   // some fixed faces among those sampled
+            x[f] = unknown[f] ? uniform(random) : 0.0;
         }
+        const double c = 1e4;
+        fluid::SurfacePreconditioner preconditioner;
+        preconditioner.build(*term, c, diagonal, unknown);
+        ASSERT_TRUE(preconditioner.built());
+        std::vector<double> y(faces, 0.0);
+        term->add_stiffness(c, x, y);
+        double largest = 0.0;
+        for (std::size_t f = 0; f < faces; ++f) {
+            y[f] = unknown[f] ? y[f] + diagonal[f] * x[f] : 0.0;
+            largest = std::max(largest, std::abs(y[f]));
+        }
+        EXPECT_GT(largest, 100.0);  // the surface term dominates
+        std::vector<double> back;
+        preconditioner.apply(y, back);
+        double error = 0.0;
+        for (std::size_t f = 0; f < faces; ++f)
+            error = std::max(error, std::abs(back[f] - x[f]));
+        EXPECT_LT(error, 1e-7);  // of |x| ≤ 1, through a system of condition about c (3e-8, 5e-9)
+        // Symmetric: r₁ · M⁻¹ r₂ = r₂ · M⁻¹ r₁.
+        std::vector<double> r1(faces), r2(faces), z1, z2;
+        for (std::size_t f = 0; f < faces; ++f) {
+            r1[f] = unknown[f] ? uniform(random) : 0.0;
+            r2[f] = unknown[f] ? uniform(random) : 0.0;
+        }
+        preconditioner.apply(r1, z1);
+        preconditioner.apply(r2, z2);
+        EXPECT_NEAR(dot(r1, z2), dot(r2, z1), 1e-12 * std::abs(dot(r1, z2)));
+        for (std::size_t f = 0; f < faces; ++f) {
+            if (!unknown[f]) {
+                EXPECT_EQ(z1[f], 0.0);
+            }
+        }
+        // Sizes that do not fit are refused.
+        EXPECT_THROW(preconditioner.build(*term, c, std::vector<double>(faces - 1, 1.0), unknown),
+                     std::invalid_argument);
     }
-    // Sizes that do not fit are refused.
-    EXPECT_THROW(preconditioner.build(*term, c, std::vector<double>(faces - 1, 1.0), unknown),
-                 std::invalid_argument);
 }
 
 /// A gas bubble in water at 3.5 times the capillary step limit, the term sampled trilinearly
 /// (not weighted by density): the surface viscosity θσΔt is then far stiffer than the gas faces'
 /// mass. With the surface term in the preconditioner (jacobi_surface) the viscous CG converges
 /// in 19 iterations from a random field, where the plain diagonal and hypre's PFMG V-cycles
-/// (which see the term only through its diagonal) take 66, to the same answer.
+/// (which see the term only through its diagonal) take 100 (66 with the full form, whose
+/// blocks do not couple the components), to the same answer.
 TEST(ImplicitTension, ViscousSolvePastTheCapillaryLimitConvergesInAFewIterations) {
     const int n = 24;
     const double dx = 1e-4;
@@ -273,8 +352,8 @@ TEST(ImplicitTension, ViscousSolvePastTheCapillaryLimitConvergesInAFewIterations
     const int jacobi = solve(fluid::ViscousPreconditioner::jacobi, jacobi_grid);
     const int pfmg = solve(fluid::ViscousPreconditioner::hypre_pfmg, pfmg_grid);
     EXPECT_LE(surface, 20);
-    EXPECT_GT(jacobi, 2 * surface);  // 66 against 19
-    EXPECT_GT(pfmg, 2 * surface);    // 66
+    EXPECT_GT(jacobi, 2 * surface);  // 100 against 19
+    EXPECT_GT(pfmg, 2 * surface);    // 101
     for (const fluid::MacGrid* other : {&jacobi_grid, &pfmg_grid}) {
         double difference = 0.0;
         for (int axis = 0; axis < 3; ++axis)

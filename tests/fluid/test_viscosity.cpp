@@ -237,11 +237,11 @@ TEST(FluidViscosity, SurfaceViscosityTermRelaxesTwoCoupledFacesExactly) {
                                                      grid.w().size()));
     term->sample.insert(0, static_cast<Eigen::Index>(a)) = 1.0;  // point 0, x
     term->sample.insert(3, static_cast<Eigen::Index>(b)) = 1.0;  // point 1, x
-    term->laplacian.resize(2, 2);
-    term->laplacian.insert(0, 0) = 1.0;
-    term->laplacian.insert(0, 1) = -1.0;
-    term->laplacian.insert(1, 0) = -1.0;
-    term->laplacian.insert(1, 1) = 1.0;
+    term->stiffness.resize(6, 6);  // L ⊗ I₃ with only the x rows sampled
+    term->stiffness.insert(0, 0) = 1.0;
+    term->stiffness.insert(0, 3) = -1.0;
+    term->stiffness.insert(3, 0) = -1.0;
+    term->stiffness.insert(3, 3) = 1.0;
     term->viscosity = 0.05;  // Pa·s·m
     interface.surface_viscosity = term;
     PhaseOptions phases;
