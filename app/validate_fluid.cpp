@@ -624,7 +624,8 @@ struct Runner : CaseContext {
         if (comparison.empty())
             return "";
         const Json& explicit_run = comparison[0];
-        md << "Semi-implicit surface tension (`/coupling/implicit_tension` 1, Hysing 2006) at "
+        md << "Semi-implicit surface tension (`/coupling/implicit_tension` 1, Hysing 2006, in "
+              "its normal form) at "
            << fmt(IMPLICIT_DT_FACTOR, "%.3g")
            << "× the capillary limit, beside the explicit run at the solver's own Δt, both with "
               "trilinear vertex velocities (`/coupling/velocity_interpolation` trilinear, which "

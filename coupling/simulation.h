@@ -45,11 +45,11 @@ struct SimulationOptions {
     /// the viscous solve (0 = explicit, the default; at most 1). Each capillary mode then loses
     /// a factor 1/sqrt(1 + θ(ωΔt)²) of its amplitude per step instead of growing past the
     /// explicit limit, so capillary_safety may exceed 1; the price is that extra damping, about
-    /// θω²Δt/2 for a mode of frequency ω (validate B4 at 3×: γ 0.78 against 0.05 1/s; B2 26.7
-    /// against 1.45). The coupled viscous–pressure passes do not converge with the term (8 of 8):
-    /// large runs are best done with the incremental scheme (docs/validation.md). θ = 1 is the
-    /// validated value: θ = ½ let the capillary wave grow unstable at
-    /// 3× the limit (max|u| 1.8 m/s against 0.1). Needs interpolate.method trilinear:
+    /// θω²Δt/2 for a mode of frequency ω (validate B4 at 3×: γ 0.78 against 0.05 1/s; B2 11.4
+    /// against 1.45, 26.7 with the full form). The coupled viscous–pressure passes do not converge
+    /// with the term (8 of 8): large runs are best done with the incremental scheme
+    /// (docs/validation.md). θ = 1 is the validated value: θ = ½ let the capillary wave grow
+    /// unstable at 3× the limit (max|u| 1.8 m/s against 0.1). Needs interpolate.method trilinear:
     /// with the one-sided vertex velocities a water drop in air (validate B2, 12 cells per
     /// diameter) at 3× the limit grew unstable within 4 ms whether the term sampled the grid as
     /// the one-sided method or trilinearly (max|u| 0.063 and 0.038 m/s against the explicit
