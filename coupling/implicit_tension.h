@@ -38,7 +38,8 @@ namespace meniscus::coupling {
 /// - `full`: Hysing's ∫ ∇_Γ u : ∇_Γ v over all three components. It damps the surface's
 ///   stretching along itself as well, a surface viscosity θσΔt that made bubble_merge's
 ///   interfaces immobile: the film between the bubbles did not drain (30 cells: the bubbles did
-///   not merge in 40 ms at any step, against 10–12 ms explicit; 128 cells: merged 8 ms late).
+///   not merge in 24 ms at the explicit step nor in 40 ms at 3.5× it, against 10–12 ms explicit;
+///   128 cells: merged 8 ms late).
 enum class SurfaceTermForm { normal, full };
 
 /// The term with μ_s = `viscosity` (Pa·s·m; θσΔt) for `mesh` on `grid`, its sampling weighted
