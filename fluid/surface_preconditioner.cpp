@@ -67,8 +67,8 @@ void SurfacePreconditioner::apply(const std::vector<double>& r, std::vector<doub
         return;
     const Eigen::VectorXd sampled = m_sample * zv;  // S D⁻¹ r
     const Eigen::VectorXd solved = m_system->solve(m_stiffness * sampled);
-    for (Eigen::Index row = 0; row < m_sample.outerSize();
-         ++row)  // z −= D⁻¹ Sᵀ (I + B G)⁻¹ B S D⁻¹ r
+    // z −= D⁻¹ Sᵀ (I + B G)⁻¹ B S D⁻¹ r
+    for (Eigen::Index row = 0; row < m_sample.outerSize(); ++row)
         for (RowMatrix::InnerIterator it(m_sample, row); it; ++it)
             zv[it.col()] -= m_inverse_diagonal[it.col()] * it.value() * solved[row];
 }
