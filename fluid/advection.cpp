@@ -7,21 +7,90 @@
 #include <array>
 #include <stdexcept>
 
+#include "fluid/clamped_trilinear.h"
+
 namespace meniscus::fluid {
 
 namespace {
 
 constexpr double HALF = 0.5;
 
-/// Velocity in cell units per second (m/s ÷ dx) at a point given in cell units.
-Eigen::Vector3d grid_velocity(const std::array<const Array3<double>*, 3>& velocity,
-                              const Eigen::Vector3d& g, double inverse_dx,
-                              const Periodicity& periodic) {
-    return inverse_dx *
-           Eigen::Vector3d(interpolate_trilinear(*velocity[0], FieldLocation::x_face, g, periodic),
-                           interpolate_trilinear(*velocity[1], FieldLocation::y_face, g, periodic),
-                           interpolate_trilinear(*velocity[2], FieldLocation::z_face, g, periodic));
-}
+/// The samplers of a box without periodic axes: the inlined ClampedTrilinear.
+class ClampedSamplers {
+public:
+    ClampedSamplers(const std::array<const Array3<double>*, 3>& velocity, double inverse_dx)
+        : m_u(*velocity[0], field_offset(FieldLocation::x_face)),
+          m_v(*velocity[1], field_offset(FieldLocation::y_face)),
+          m_w(*velocity[2], field_offset(FieldLocation::z_face)),
+          m_inverse_dx(inverse_dx) {}
+
+    /// Velocity in cell units per second (m/s ÷ dx) at a point given in cell units.
+    Eigen::Vector3d velocity(const Eigen::Vector3d& g) const {
+        return m_inverse_dx * Eigen::Vector3d(m_u.value(g), m_v.value(g), m_w.value(g));
+    }
+
+    /// A sampler of one advected field.
+    class Field {
+    public:
+        Field(const Array3<double>& field, FieldLocation location)
+            : m_sampler(field, field_offset(location)) {}
+        double value(const Eigen::Vector3d& g) const { return m_sampler.value(g); }
+        TrilinearSample sample(const Eigen::Vector3d& g) const { return m_sampler.sample(g); }
+
+    private:
+        ClampedTrilinear m_sampler;
+    };
+
+    Field field(const Array3<double>& in, FieldLocation location) const {
+        return Field(in, location);
+    }
+
+private:
+    ClampedTrilinear m_u, m_v, m_w;
+    double m_inverse_dx;
+};
+
+/// The samplers of a box with periodic axes: mac_grid.h's wrapping interpolation.
+class PeriodicSamplers {
+public:
+    PeriodicSamplers(const std::array<const Array3<double>*, 3>& velocity, double inverse_dx,
+                     const Periodicity& periodic)
+        : m_velocity(velocity), m_inverse_dx(inverse_dx), m_periodic(periodic) {}
+
+    Eigen::Vector3d velocity(const Eigen::Vector3d& g) const {
+        return m_inverse_dx *
+               Eigen::Vector3d(
+                   interpolate_trilinear(*m_velocity[0], FieldLocation::x_face, g, m_periodic),
+                   interpolate_trilinear(*m_velocity[1], FieldLocation::y_face, g, m_periodic),
+                   interpolate_trilinear(*m_velocity[2], FieldLocation::z_face, g, m_periodic));
+    }
+
+    class Field {
+    public:
+        Field(const Array3<double>& field, FieldLocation location, const Periodicity& periodic)
+            : m_field(field), m_location(location), m_periodic(periodic) {}
+        double value(const Eigen::Vector3d& g) const {
+            return interpolate_trilinear(m_field, m_location, g, m_periodic);
+        }
+        TrilinearSample sample(const Eigen::Vector3d& g) const {
+            return sample_trilinear(m_field, m_location, g, m_periodic);
+        }
+
+    private:
+        const Array3<double>& m_field;
+        FieldLocation m_location;
+        const Periodicity& m_periodic;
+    };
+
+    Field field(const Array3<double>& in, FieldLocation location) const {
+        return Field(in, location, m_periodic);
+    }
+
+private:
+    std::array<const Array3<double>*, 3> m_velocity;
+    double m_inverse_dx;
+    const Periodicity& m_periodic;
+};
 
 /// The axis whose faces hold a field at `location` (−1 for cell centres).
 int face_axis(FieldLocation location) {
@@ -95,48 +164,89 @@ void apply_tangential_inflows(const std::vector<TangentialInflow>& faces, const 
     }
 }
 
-/// One semi-Lagrangian pass: out(x) = in(x − dt·u) with RK2 back-tracing; `dt` may be negative
-/// (forward trace). When bounds are requested, the min/max of the interpolation stencil is stored.
-/// `inflows`: the inflow faces to which the field's samples are tangential.
-void semi_lagrangian(const std::array<const Array3<double>*, 3>& velocity, double inverse_dx,
-                     double dt, FieldLocation location, const Array3<double>& in,
-                     Array3<double>& out, Array3<double>* lower, Array3<double>* upper,
-                     const std::vector<TangentialInflow>& inflows, const Periodicity& periodic) {
+/// One semi-Lagrangian pass: the value of `in` at x − dt·u for every sample x, with RK2
+/// back-tracing; `dt` may be negative (forward trace). Calls emit(c, sample) for each flat index
+/// c, with the min/max of the interpolation stencil when `Bounds` (else only sample.value is
+/// set); wall-normal face samples (kept fixed) pass their own value. `inflows`: the inflow faces
+/// to which the field's samples are tangential.
+template <bool Bounds, class Samplers, class Emit>
+void semi_lagrangian(const Samplers& samplers, double dt, FieldLocation location,
+                     const Array3<double>& in, const std::vector<TangentialInflow>& inflows,
+                     const Periodicity& periodic, Emit&& emit) {
     const Eigen::Vector3d offset = field_offset(location);
+    const auto field = samplers.field(in, location);
     tbb::parallel_for(tbb::blocked_range<int>(0, in.nk()), [&](const tbb::blocked_range<int>& r) {
         for (int k = r.begin(); k != r.end(); ++k) {
             for (int j = 0; j < in.nj(); ++j) {
+                const std::size_t row = in.index(0, j, k);
                 for (int i = 0; i < in.ni(); ++i) {
-                    const std::size_t c = in.index(i, j, k);
+                    const std::size_t c = row + static_cast<std::size_t>(i);
                     if (is_fixed_sample(location, in, i, j, k, periodic)) {
-                        out[c] = in[c];
-                        if (lower != nullptr) {
-                            (*lower)[c] = in[c];
-                            (*upper)[c] = in[c];
-                        }
+                        emit(c, TrilinearSample{in[c], in[c], in[c]});
                         continue;
                     }
                     const Eigen::Vector3d start = Eigen::Vector3d(i, j, k) + offset;
-                    const Eigen::Vector3d mid =
-                        start - HALF * dt * grid_velocity(velocity, start, inverse_dx, periodic);
-                    const Eigen::Vector3d departure =
-                        start - dt * grid_velocity(velocity, mid, inverse_dx, periodic);
-                    if (lower != nullptr || !inflows.empty()) {
-                        TrilinearSample sample =
-                            sample_trilinear(in, location, departure, periodic);
+                    const Eigen::Vector3d mid = start - HALF * dt * samplers.velocity(start);
+                    const Eigen::Vector3d departure = start - dt * samplers.velocity(mid);
+                    TrilinearSample sample;
+                    if (Bounds || !inflows.empty()) {
+                        sample = field.sample(departure);
                         apply_tangential_inflows(inflows, departure, sample);
-                        out[c] = sample.value;
-                        if (lower != nullptr) {
-                            (*lower)[c] = sample.min;
-                            (*upper)[c] = sample.max;
-                        }
                     } else {
-                        out[c] = interpolate_trilinear(in, location, departure, periodic);
+                        sample.value = field.value(departure);
                     }
+                    emit(c, sample);
                 }
             }
         }
     });
+}
+
+/// advect_field() with the samplers of the grid's boundaries.
+template <class Samplers>
+void advect_with(const Samplers& samplers, double dt, FieldLocation location,
+                 const AdvectionOptions& options, Array3<double>& field,
+                 const std::vector<TangentialInflow>& inflows, const Periodicity& periodic) {
+    const int ni = field.ni(), nj = field.nj(), nk = field.nk();
+    Array3<double> forward(ni, nj, nk);
+    Array3<double> lower(ni, nj, nk), upper(ni, nj, nk);
+    semi_lagrangian<true>(samplers, dt, location, field, inflows, periodic,
+                          [&](std::size_t c, const TrilinearSample& s) {
+                              forward[c] = s.value;
+                              lower[c] = s.min;
+                              upper[c] = s.max;
+                          });
+    // A corrected value outside the forward stencil's range falls back to the forward one.
+    const auto limited = [&](std::size_t c, double corrected) {
+        return (corrected < lower[c] || corrected > upper[c]) ? forward[c] : corrected;
+    };
+    switch (options.scheme) {
+        case AdvectionScheme::semi_lagrangian:
+            field = std::move(forward);
+            break;
+        case AdvectionScheme::maccormack:
+            // φ1 + (φ0 − φ̂0)/2, φ̂0 the forward result traced back: each sample reads φ0 at its
+            // own index only, so the result overwrites φ0 in place.
+            semi_lagrangian<false>(samplers, -dt, location, forward, inflows, periodic,
+                                   [&](std::size_t c, const TrilinearSample& s) {
+                                       field[c] =
+                                           limited(c, forward[c] + HALF * (field[c] - s.value));
+                                   });
+            break;
+        case AdvectionScheme::bfecc: {
+            // Advect φ0 + (φ0 − φ̂0)/2 forward again.
+            Array3<double> compensated(ni, nj, nk);
+            semi_lagrangian<false>(samplers, -dt, location, forward, inflows, periodic,
+                                   [&](std::size_t c, const TrilinearSample& s) {
+                                       compensated[c] = field[c] + HALF * (field[c] - s.value);
+                                   });
+            semi_lagrangian<false>(
+                samplers, dt, location, compensated, inflows, periodic,
+                [&](std::size_t c, const TrilinearSample& s) { field[c] = limited(c, s.value); });
+            break;
+        }
+    }
+    copy_seam(location, periodic, field);
 }
 
 }  // namespace
@@ -156,39 +266,12 @@ void advect_field(const MacGrid& grid, double dt, FieldLocation location,
     const std::array<const Array3<double>*, 3> velocity = {&grid.u(), &grid.v(), &grid.w()};
     const double inverse_dx = 1.0 / grid.dx();
     const Periodicity& periodic = grid.periodic();
-    const int ni = field.ni(), nj = field.nj(), nk = field.nk();
-    Array3<double> forward(ni, nj, nk);
-    Array3<double> lower(ni, nj, nk), upper(ni, nj, nk);
-    semi_lagrangian(velocity, inverse_dx, dt, location, field, forward, &lower, &upper, inflows,
-                    periodic);
-    if (options.scheme == AdvectionScheme::semi_lagrangian) {
-        field = std::move(forward);
-        copy_seam(location, periodic, field);
-        return;
-    }
-    Array3<double> backward(ni, nj, nk);
-    semi_lagrangian(velocity, inverse_dx, -dt, location, forward, backward, nullptr, nullptr,
+    if (periodic[0] || periodic[1] || periodic[2])
+        advect_with(PeriodicSamplers(velocity, inverse_dx, periodic), dt, location, options, field,
                     inflows, periodic);
-    Array3<double> corrected(ni, nj, nk);
-    if (options.scheme == AdvectionScheme::bfecc) {
-        // Advect φ0 + (φ0 − φ̂0)/2 forward again.
-        Array3<double> compensated(ni, nj, nk);
-        for (std::size_t c = 0; c < field.size(); ++c) {
-            compensated[c] = field[c] + HALF * (field[c] - backward[c]);
-        }
-        semi_lagrangian(velocity, inverse_dx, dt, location, compensated, corrected, nullptr,
-                        nullptr, inflows, periodic);
-    } else {
-        // MacCormack: φ1 + (φ0 − φ̂0)/2.
-        for (std::size_t c = 0; c < field.size(); ++c) {
-            corrected[c] = forward[c] + HALF * (field[c] - backward[c]);
-        }
-    }
-    for (std::size_t c = 0; c < field.size(); ++c) {
-        const double value = corrected[c];
-        field[c] = (value < lower[c] || value > upper[c]) ? forward[c] : value;
-    }
-    copy_seam(location, periodic, field);
+    else
+        advect_with(ClampedSamplers(velocity, inverse_dx), dt, location, options, field, inflows,
+                    periodic);
 }
 
 void advect_velocity(MacGrid& grid, double dt, const AdvectionOptions& options,

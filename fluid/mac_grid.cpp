@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "fluid/clamped_trilinear.h"
+
 namespace meniscus::fluid {
 
 namespace {
@@ -70,73 +72,54 @@ void split_periodic(double s, int period, int& first, int& second, double& fract
     second = first + 1 == period ? 0 : first + 1;
 }
 
-Stencil gather_stencil(const Array3<double>& field, FieldLocation location,
-                       const Eigen::Vector3d& grid_position, const Periodicity& periodic) {
+/// The stencil around `grid_position` on a box with at least one periodic axis (the others
+/// clamped as ClampedTrilinear does).
+Stencil gather_periodic_stencil(const Array3<double>& field, FieldLocation location,
+                                const Eigen::Vector3d& grid_position, const Periodicity& periodic) {
     const Eigen::Vector3d s = grid_position - field_offset(location);
     Stencil st;
-    if (periodic[0] || periodic[1] || periodic[2]) {
-        const std::array<int, 3> n = {field.ni(), field.nj(), field.nk()};
-        std::array<int, 3> lo{}, hi{};
-        double* fraction[3] = {&st.fx, &st.fy, &st.fz};
-        for (int a = 0; a < 3; ++a) {
-            const auto ax = static_cast<std::size_t>(a);
-            if (periodic[ax]) {
-                // A face field along its own axis holds the seam twice (0 and n).
-                const int period = location == face_location(a) ? n[ax] - 1 : n[ax];
-                split_periodic(s[a], period, lo[ax], hi[ax], *fraction[a]);
-            } else {
-                split_coordinate(s[a], n[ax], lo[ax], *fraction[a]);
-                hi[ax] = n[ax] > 1 ? lo[ax] + 1 : lo[ax];
-            }
+    const std::array<int, 3> n = {field.ni(), field.nj(), field.nk()};
+    std::array<int, 3> lo{}, hi{};
+    double* fraction[3] = {&st.fx, &st.fy, &st.fz};
+    for (int a = 0; a < 3; ++a) {
+        const auto ax = static_cast<std::size_t>(a);
+        if (periodic[ax]) {
+            // A face field along its own axis holds the seam twice (0 and n).
+            const int period = location == face_location(a) ? n[ax] - 1 : n[ax];
+            split_periodic(s[a], period, lo[ax], hi[ax], *fraction[a]);
+        } else {
+            split_coordinate(s[a], n[ax], lo[ax], *fraction[a]);
+            hi[ax] = n[ax] > 1 ? lo[ax] + 1 : lo[ax];
         }
-        for (int corner = 0; corner < 8; ++corner)
-            st.c[corner] = field((corner & 1) ? hi[0] : lo[0], (corner & 2) ? hi[1] : lo[1],
-                                 (corner & 4) ? hi[2] : lo[2]);
-        return st;
     }
-    int i0, j0, k0;
-    split_coordinate(s.x(), field.ni(), i0, st.fx);
-    split_coordinate(s.y(), field.nj(), j0, st.fy);
-    split_coordinate(s.z(), field.nk(), k0, st.fz);
-    const std::size_t di = field.ni() > 1 ? 1 : 0;
-    const std::size_t dj = field.nj() > 1 ? static_cast<std::size_t>(field.ni()) : 0;
-    const std::size_t dk = field.nk() > 1 ? static_cast<std::size_t>(field.ni()) * field.nj() : 0;
-    const std::size_t base = field.index(i0, j0, k0);
-    const double* f = field.data();
-    st.c[0] = f[base];
-    st.c[1] = f[base + di];
-    st.c[2] = f[base + dj];
-    st.c[3] = f[base + dj + di];
-    st.c[4] = f[base + dk];
-    st.c[5] = f[base + dk + di];
-    st.c[6] = f[base + dk + dj];
-    st.c[7] = f[base + dk + dj + di];
+    for (int corner = 0; corner < 8; ++corner)
+        st.c[corner] = field((corner & 1) ? hi[0] : lo[0], (corner & 2) ? hi[1] : lo[1],
+                             (corner & 4) ? hi[2] : lo[2]);
     return st;
 }
 
-double blend(const Stencil& st) {
-    const double c00 = st.c[0] + st.fx * (st.c[1] - st.c[0]);
-    const double c10 = st.c[2] + st.fx * (st.c[3] - st.c[2]);
-    const double c01 = st.c[4] + st.fx * (st.c[5] - st.c[4]);
-    const double c11 = st.c[6] + st.fx * (st.c[7] - st.c[6]);
-    const double c0 = c00 + st.fy * (c10 - c00);
-    const double c1 = c01 + st.fy * (c11 - c01);
-    return c0 + st.fz * (c1 - c0);
+bool any_periodic(const Periodicity& periodic) {
+    return periodic[0] || periodic[1] || periodic[2];
 }
 
 }  // namespace
 
 double interpolate_trilinear(const Array3<double>& field, FieldLocation location,
                              const Eigen::Vector3d& grid_position, const Periodicity& periodic) {
-    return blend(gather_stencil(field, location, grid_position, periodic));
+    if (!any_periodic(periodic))
+        return ClampedTrilinear(field, field_offset(location)).value(grid_position);
+    const Stencil st = gather_periodic_stencil(field, location, grid_position, periodic);
+    return ClampedTrilinear::blend(st.c, st.fx, st.fy, st.fz);
 }
 
 TrilinearSample sample_trilinear(const Array3<double>& field, FieldLocation location,
                                  const Eigen::Vector3d& grid_position,
                                  const Periodicity& periodic) {
-    const Stencil st = gather_stencil(field, location, grid_position, periodic);
+    if (!any_periodic(periodic))
+        return ClampedTrilinear(field, field_offset(location)).sample(grid_position);
+    const Stencil st = gather_periodic_stencil(field, location, grid_position, periodic);
     TrilinearSample sample;
-    sample.value = blend(st);
+    sample.value = ClampedTrilinear::blend(st.c, st.fx, st.fy, st.fz);
     sample.min = *std::min_element(st.c, st.c + 8);
     sample.max = *std::max_element(st.c, st.c + 8);
     return sample;
