@@ -145,6 +145,33 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
         std::plus<double>());
 }
 
+ResidualDots jacobi_cg_update(double alpha, const std::vector<double>& p,
+                              const std::vector<double>& q, const std::vector<double>& d,
+                              std::vector<double>& x, std::vector<double>& r,
+                              std::vector<double>& z) {
+    const double* pv = p.data();
+    const double* qv = q.data();
+    const double* dv = d.data();
+    double* xv = x.data();
+    double* rv = r.data();
+    double* zv = z.data();
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, r.size(), VECTOR_GRAIN), ResidualDots{},
+        [&](const tbb::blocked_range<std::size_t>& range, ResidualDots sums) {
+            for (std::size_t c = range.begin(); c != range.end(); ++c) {
+                xv[c] += alpha * pv[c];
+                rv[c] -= alpha * qv[c];
+                zv[c] = rv[c] / dv[c];
+                sums.rr += rv[c] * rv[c];
+                sums.rz += rv[c] * zv[c];
+            }
+            return sums;
+        },
+        [](const ResidualDots& a, const ResidualDots& b) {
+            return ResidualDots{a.rr + b.rr, a.rz + b.rz};
+        });
+}
+
 void axpy(double alpha, const std::vector<double>& x, std::vector<double>& y) {
     const double* xv = x.data();
     double* yv = y.data();

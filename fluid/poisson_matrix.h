@@ -61,6 +61,17 @@ double dot(const std::vector<double>& a, const std::vector<double>& b);
 void axpy(double alpha, const std::vector<double>& x, std::vector<double>& y);
 /// y = x + beta y (TBB-parallel).
 void xpby(const std::vector<double>& x, double beta, std::vector<double>& y);
+/// r·r and r·z after a conjugate-gradient update.
+struct ResidualDots {
+    double rr = 0.0;
+    double rz = 0.0;
+};
+/// One Jacobi-preconditioned CG update in a single pass: x += alpha p, r −= alpha q, z = r / d,
+/// returning r·r and r·z (summed in dot()'s order, so the same values as separate calls).
+ResidualDots jacobi_cg_update(double alpha, const std::vector<double>& p,
+                              const std::vector<double>& q, const std::vector<double>& d,
+                              std::vector<double>& x, std::vector<double>& r,
+                              std::vector<double>& z);
 /// Subtracts the mean over active cells of `matrix` from x on those cells (projection onto the
 /// complement of the constant null space of a pure-Neumann operator).
 void remove_active_mean(const PoissonMatrix& matrix, std::vector<double>& x);

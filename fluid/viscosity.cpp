@@ -337,6 +337,8 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
                 offset += size;
             }
         };
+        // On one process the plain diagonal's update, residual and dot products take one pass.
+        const bool fused_jacobi = !distributed && diagonal_kind && !surface_jacobi;
         r.resize(n);
         z.resize(n);
         op.apply(x, q);
@@ -356,13 +358,20 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
                 break;
             }
             const double alpha = rz / curvature;
-            axpy(alpha, p, x);
-            axpy(-alpha, q, r);
             ++result.iterations;
-            result.residual = std::sqrt(global_dot(r, r)) / b_norm;
+            double rz_new = 0.0;
+            if (fused_jacobi) {
+                const ResidualDots dots = jacobi_cg_update(alpha, p, q, diagonal, x, r, z);
+                result.residual = std::sqrt(dots.rr) / b_norm;
+                rz_new = dots.rz;
+            } else {
+                axpy(alpha, p, x);
+                axpy(-alpha, q, r);
+                result.residual = std::sqrt(global_dot(r, r)) / b_norm;
+                precondition();
+                rz_new = global_dot(r, z);
+            }
             result.converged = result.residual <= options.iteration.tolerance;
-            precondition();
-            const double rz_new = global_dot(r, z);
             xpby(z, rz_new / rz, p);
             rz = rz_new;
         }

@@ -126,9 +126,11 @@ void ViscousOperator::stiffness(const std::vector<double>& x, std::vector<double
 
 void ViscousOperator::apply(const std::vector<double>& x, std::vector<double>& y) const {
     stiffness(x, y);
-    for (std::size_t f = 0; f < m_size; ++f) {
-        y[f] = m_unknown[f] ? y[f] + m_density[f] * x[f] : 0.0;
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_size),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t f = r.begin(); f != r.end(); ++f)
+                              y[f] = m_unknown[f] ? y[f] + m_density[f] * x[f] : 0.0;
+                      });
 }
 
 void ViscousOperator::diagonal(std::vector<double>& d, bool with_surface) const {
@@ -199,19 +201,6 @@ void ViscousOperator::component_blocks(const std::vector<double>& d,
             }
         });
     }
-}
-
-bool ViscousOperator::solvable(int a, const Index3& f) const {
-    if (f[a] == 0)  // across a periodic axis the face at 0 is the seam; the one at n its copy
-        return m_open[a][0] || periodic(a);
-    return f[a] != m_n[a] || m_open[a][1];
-}
-
-std::size_t ViscousOperator::face_flat(int a, const Index3& f) const {
-    const Index3& d = m_face_dims[a];
-    return m_offset[a] + static_cast<std::size_t>(f[0]) +
-           static_cast<std::size_t>(d[0]) *
-               (static_cast<std::size_t>(f[1]) + static_cast<std::size_t>(d[1]) * f[2]);
 }
 
 double ViscousOperator::control_volume_fraction(double phi) const {
@@ -329,18 +318,23 @@ void ViscousOperator::normal_stresses(const std::vector<double>& x) const {
     const double scale = 2.0 * m_dt / m_dx;
     for (int a = 0; a < 3; ++a) {
         Array3<double>& sigma = m_normal_stress[a];
+        const std::size_t step = face_stride(a, a);
+        // The cell below the face at n along a periodic a takes the seam's face at 0 as its hi.
+        const std::size_t seam_back = static_cast<std::size_t>(m_n[a] - 1) * step;
+        const bool wrap = periodic(a);
         tbb::parallel_for(
             tbb::blocked_range<int>(0, m_n[2]), [&](const tbb::blocked_range<int>& r) {
                 for (int k = r.begin(); k != r.end(); ++k) {
                     for (int j = 0; j < m_n[1]; ++j) {
+                        const std::size_t face_row = face_flat(a, {0, j, k});
+                        const std::size_t cell_row = sigma.index(0, j, k);
+                        const int row_along = a == 1 ? j : k;  // the row's index along a ≠ 0
                         for (int i = 0; i < m_n[0]; ++i) {
-                            const Index3 c = {i, j, k};
-                            Index3 hi = c;
-                            ++hi[a];
-                            if (hi[a] == m_n[a] && periodic(a))
-                                hi[a] = 0;  // the face at n is the seam's copy
-                            sigma(i, j, k) =
-                                scale * m_mu(i, j, k) * (x[face_flat(a, hi)] - x[face_flat(a, c)]);
+                            const std::size_t lo = face_row + static_cast<std::size_t>(i);
+                            const int along = a == 0 ? i : row_along;
+                            const std::size_t hi =
+                                wrap && along + 1 == m_n[a] ? lo - seam_back : lo + step;
+                            sigma[cell_row + i] = scale * m_mu[cell_row + i] * (x[hi] - x[lo]);
                         }
                     }
                 }

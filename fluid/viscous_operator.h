@@ -72,9 +72,19 @@ private:
     void for_each_face(int a, Visit&& visit) const;
 
     /// Is face f of component a inside the box or on one of its outflow faces?
-    bool solvable(int a, const Index3& f) const;
+    bool solvable(int a, const Index3& f) const {
+        if (f[a] == 0)  // across a periodic axis the face at 0 is the seam; the one at n its copy
+            return m_open[a][0] || periodic(a);
+        return f[a] != m_n[a] || m_open[a][1];
+    }
 
-    std::size_t face_flat(int a, const Index3& f) const;
+    /// Index of face f of component a in the stacked [u|v|w] vector.
+    std::size_t face_flat(int a, const Index3& f) const {
+        const Index3& d = m_face_dims[a];
+        return m_offset[a] + static_cast<std::size_t>(f[0]) +
+               static_cast<std::size_t>(d[0]) *
+                   (static_cast<std::size_t>(f[1]) + static_cast<std::size_t>(d[1]) * f[2]);
+    }
 
     /// Liquid fraction of a cube of edge dx centred where the level set is `phi`: exact for a
     /// plane parallel to a face, 1 and 0 a half cell inside and outside (free_surface weights).
