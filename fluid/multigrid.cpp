@@ -237,12 +237,12 @@ void take_seam_planes(const PoissonMatrix& a, const std::vector<double>& x, Seam
     }
 }
 
-/// One red–black Gauss–Seidel half sweep over cells with (i + j + k) % 2 == colour. Neighbours
-/// across a periodic seam are read from `seams` (take_seam_planes() of x before the sweep).
-/// `Wrap` false compiles the loop without the seam's branches (bounded boxes keep the old speed).
+/// One red–black Gauss–Seidel half sweep over the cells of plane k with (i + j + k) % 2 ==
+/// colour. Neighbours across a periodic seam are read from `seams` (take_seam_planes() of x
+/// before the half sweep). `Wrap` false compiles the loop without the seam's branches.
 template <bool Wrap>
-void smooth_colour_kernel(const PoissonMatrix& a, const std::vector<double>& b,
-                          std::vector<double>& x, int colour, SeamPlanes& seams) {
+void smooth_plane(const PoissonMatrix& a, const std::vector<double>& b, std::vector<double>& x,
+                  int colour, int k, const SeamPlanes& seams) {
     const int ni = a.ni(), nj = a.nj(), nk = a.nk();
     const std::size_t sj = static_cast<std::size_t>(ni);
     const std::size_t sk = static_cast<std::size_t>(ni) * nj;
@@ -253,51 +253,57 @@ void smooth_colour_kernel(const PoissonMatrix& a, const std::vector<double>& b,
     const double* bv = b.data();
     double* xv = x.data();
     const bool px = Wrap && a.periodic[0], py = Wrap && a.periodic[1], pz = Wrap && a.periodic[2];
-    if (Wrap)
-        take_seam_planes(a, x, seams);
-    tbb::parallel_for(tbb::blocked_range<int>(0, nk), [&](const tbb::blocked_range<int>& range) {
-        for (int k = range.begin(); k != range.end(); ++k) {
-            for (int j = 0; j < nj; ++j) {
-                const std::size_t row = sk * k + sj * j;
-                for (int i = (j + k + colour) % 2; i < ni; i += 2) {
-                    const std::size_t c = row + i;
-                    if (a_d[c] <= 0.0) {
-                        continue;
-                    }
-                    double sum = bv[c];
-                    if (i + 1 < ni)
-                        sum -= a_x[c] * xv[c + 1];
-                    else if (Wrap && px)
-                        sum -= a_x[c] * seams.first[0][plane_index(0, i, j, k, ni, nj)];
-                    if (i > 0)
-                        sum -= a_x[c - 1] * xv[c - 1];
-                    else if (Wrap && px)
-                        sum -= a_x[c + sj - 1] * seams.last[0][plane_index(0, i, j, k, ni, nj)];
-                    if (j + 1 < nj)
-                        sum -= a_y[c] * xv[c + sj];
-                    else if (Wrap && py)
-                        sum -= a_y[c] * seams.first[1][plane_index(1, i, j, k, ni, nj)];
-                    if (j > 0)
-                        sum -= a_y[c - sj] * xv[c - sj];
-                    else if (Wrap && py)
-                        sum -=
-                            a_y[c + sj * (nj - 1)] * seams.last[1][plane_index(1, i, j, k, ni, nj)];
-                    if (k + 1 < nk)
-                        sum -= a_z[c] * xv[c + sk];
-                    else if (Wrap && pz)
-                        sum -= a_z[c] * seams.first[2][plane_index(2, i, j, k, ni, nj)];
-                    if (k > 0)
-                        sum -= a_z[c - sk] * xv[c - sk];
-                    else if (Wrap && pz)
-                        sum -=
-                            a_z[c + sk * (nk - 1)] * seams.last[2][plane_index(2, i, j, k, ni, nj)];
-                    xv[c] = sum / a_d[c];
-                }
+    for (int j = 0; j < nj; ++j) {
+        const std::size_t row = sk * k + sj * j;
+        for (int i = (j + k + colour) % 2; i < ni; i += 2) {
+            const std::size_t c = row + i;
+            if (a_d[c] <= 0.0) {
+                continue;
             }
+            double sum = bv[c];
+            if (i + 1 < ni)
+                sum -= a_x[c] * xv[c + 1];
+            else if (Wrap && px)
+                sum -= a_x[c] * seams.first[0][plane_index(0, i, j, k, ni, nj)];
+            if (i > 0)
+                sum -= a_x[c - 1] * xv[c - 1];
+            else if (Wrap && px)
+                sum -= a_x[c + sj - 1] * seams.last[0][plane_index(0, i, j, k, ni, nj)];
+            if (j + 1 < nj)
+                sum -= a_y[c] * xv[c + sj];
+            else if (Wrap && py)
+                sum -= a_y[c] * seams.first[1][plane_index(1, i, j, k, ni, nj)];
+            if (j > 0)
+                sum -= a_y[c - sj] * xv[c - sj];
+            else if (Wrap && py)
+                sum -= a_y[c + sj * (nj - 1)] * seams.last[1][plane_index(1, i, j, k, ni, nj)];
+            if (k + 1 < nk)
+                sum -= a_z[c] * xv[c + sk];
+            else if (Wrap && pz)
+                sum -= a_z[c] * seams.first[2][plane_index(2, i, j, k, ni, nj)];
+            if (k > 0)
+                sum -= a_z[c - sk] * xv[c - sk];
+            else if (Wrap && pz)
+                sum -= a_z[c + sk * (nk - 1)] * seams.last[2][plane_index(2, i, j, k, ni, nj)];
+            xv[c] = sum / a_d[c];
         }
-    });
+    }
 }
 
+template <bool Wrap>
+void smooth_colour_kernel(const PoissonMatrix& a, const std::vector<double>& b,
+                          std::vector<double>& x, int colour, SeamPlanes& seams) {
+    if (Wrap)
+        take_seam_planes(a, x, seams);
+    tbb::parallel_for(tbb::blocked_range<int>(0, a.nk()),
+                      [&](const tbb::blocked_range<int>& range) {
+                          for (int k = range.begin(); k != range.end(); ++k)
+                              smooth_plane<Wrap>(a, b, x, colour, k, seams);
+                      });
+}
+
+/// One red–black Gauss–Seidel half sweep over cells with (i + j + k) % 2 == colour. Neighbours
+/// across a periodic seam are read from `seams` (take_seam_planes() of x before the sweep).
 void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::vector<double>& x,
                    int colour, SeamPlanes& seams) {
     if (a.any_periodic())
@@ -306,27 +312,72 @@ void smooth_colour(const PoissonMatrix& a, const std::vector<double>& b, std::ve
         smooth_colour_kernel<false>(a, b, x, colour, seams);
 }
 
-/// The first red half-sweep from x = 0: x = b / A_cc on red active cells, 0 elsewhere (same
-/// result as clearing x and calling smooth_colour(RED), in one pass without neighbour reads).
-void first_red_from_zero(const PoissonMatrix& a, const std::vector<double>& b,
-                         std::vector<double>& x) {
-    const int ni = a.ni(), nj = a.nj(), nk = a.nk();
+/// The first red half sweep from x = 0 on plane k: x = b / A_cc on red active cells, 0
+/// elsewhere (same result as clearing x and smoothing red, without neighbour reads).
+void first_red_plane(const PoissonMatrix& a, const std::vector<double>& b, std::vector<double>& x,
+                     int k) {
+    const int ni = a.ni(), nj = a.nj();
     const std::size_t sj = static_cast<std::size_t>(ni);
     const std::size_t sk = static_cast<std::size_t>(ni) * nj;
     const double* a_d = a.diag.data();
     const double* bv = b.data();
     double* xv = x.data();
-    tbb::parallel_for(tbb::blocked_range<int>(0, nk), [&](const tbb::blocked_range<int>& range) {
-        for (int k = range.begin(); k != range.end(); ++k) {
-            for (int j = 0; j < nj; ++j) {
-                const std::size_t row = sk * k + sj * j;
-                const int first_red = (j + k) % 2;
-                for (int i = 0; i < ni; ++i) {
-                    const std::size_t c = row + i;
-                    xv[c] = ((i % 2) == first_red && a_d[c] > 0.0) ? bv[c] / a_d[c] : 0.0;
-                }
-            }
+    for (int j = 0; j < nj; ++j) {
+        const std::size_t row = sk * k + sj * j;
+        const int first_red = (j + k) % 2;
+        for (int i = 0; i < ni; ++i) {
+            const std::size_t c = row + i;
+            xv[c] = ((i % 2) == first_red && a_d[c] > 0.0) ? bv[c] / a_d[c] : 0.0;
         }
+    }
+}
+
+/// first_red_plane() on every plane.
+void first_red_from_zero(const PoissonMatrix& a, const std::vector<double>& b,
+                         std::vector<double>& x) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, a.nk()),
+                      [&](const tbb::blocked_range<int>& range) {
+                          for (int k = range.begin(); k != range.end(); ++k)
+                              first_red_plane(a, b, x, k);
+                      });
+}
+
+/// Planes per task of the pipelined sweep: its extra pass touches 2 of them.
+constexpr int PIPELINE_PLANES = 16;
+
+/// Two half sweeps, `first` then the other colour, on a box without periodic axes, in one pass
+/// over memory: plane k's first half sweep, then plane k−1's second, which has all its
+/// neighbours' first-colour values by then. Each task takes a slab of planes; the second half
+/// sweep of a slab's first and last planes (whose neighbours another task updates) waits for a
+/// second pass. Same result, bit for bit, as the two half sweeps one after the other.
+/// `from_zero`: the first half sweep is first_red_plane() (x = 0 before; `first` must be red).
+void smooth_pair(const PoissonMatrix& a, const std::vector<double>& b, std::vector<double>& x,
+                 int first, bool from_zero) {
+    const int nk = a.nk();
+    const int second = 1 - first;
+    const SeamPlanes none;
+    const int slabs = (nk + PIPELINE_PLANES - 1) / PIPELINE_PLANES;
+    const auto first_half = [&](int k) {
+        if (from_zero)
+            first_red_plane(a, b, x, k);
+        else
+            smooth_plane<false>(a, b, x, first, k, none);
+    };
+    tbb::parallel_for(0, slabs, [&](int slab) {
+        const int begin = slab * PIPELINE_PLANES;
+        const int end = std::min(nk, begin + PIPELINE_PLANES);
+        for (int k = begin; k < end; ++k) {
+            first_half(k);
+            if (k - 1 > begin)
+                smooth_plane<false>(a, b, x, second, k - 1, none);
+        }
+    });
+    tbb::parallel_for(0, slabs, [&](int slab) {
+        const int begin = slab * PIPELINE_PLANES;
+        const int last = std::min(nk, begin + PIPELINE_PLANES) - 1;
+        smooth_plane<false>(a, b, x, second, begin, none);
+        if (last > begin)
+            smooth_plane<false>(a, b, x, second, last, none);
     });
 }
 
@@ -458,8 +509,8 @@ void MultigridPreconditioner::cycle(std::size_t level, const std::vector<double>
     constexpr int RED = 0;
     constexpr int BLACK = 1;
     // From x = 0 the first red half-sweep needs no neighbours; it also clears the black cells.
-    first_red_from_zero(a, b, x);
     if (level + 1 == m_levels.size()) {
+        first_red_from_zero(a, b, x);
         // Palindromic order R (B R)^n keeps the coarsest solve a symmetric operator.
         for (int sweep = 0; sweep < m_options.coarsest_sweeps; ++sweep) {
             smooth_colour(a, b, x, BLACK, data.seams);
@@ -467,10 +518,21 @@ void MultigridPreconditioner::cycle(std::size_t level, const std::vector<double>
         }
         return;
     }
-    smooth_colour(a, b, x, BLACK, data.seams);
-    for (int sweep = 1; sweep < m_options.smoothing_sweeps; ++sweep) {
-        smooth_colour(a, b, x, RED, data.seams);
+    // Without periodic axes two half sweeps take one pass (smooth_pair()).
+    const bool pipelined = m_options.pipelined_sweeps && !a.any_periodic();
+    if (pipelined) {
+        smooth_pair(a, b, x, RED, true);
+    } else {
+        first_red_from_zero(a, b, x);
         smooth_colour(a, b, x, BLACK, data.seams);
+    }
+    for (int sweep = 1; sweep < m_options.smoothing_sweeps; ++sweep) {
+        if (pipelined) {
+            smooth_pair(a, b, x, RED, false);
+        } else {
+            smooth_colour(a, b, x, RED, data.seams);
+            smooth_colour(a, b, x, BLACK, data.seams);
+        }
     }
     a.residual(x, b, data.r);
     const PoissonMatrix& coarse = level_matrix(level + 1);
@@ -479,8 +541,12 @@ void MultigridPreconditioner::cycle(std::size_t level, const std::vector<double>
     cycle(level + 1, next.b, next.x);
     prolong_add(data.transfer, coarse, next.x, a, x);
     for (int sweep = 0; sweep < m_options.smoothing_sweeps; ++sweep) {
-        smooth_colour(a, b, x, BLACK, data.seams);
-        smooth_colour(a, b, x, RED, data.seams);
+        if (pipelined) {
+            smooth_pair(a, b, x, BLACK, false);
+        } else {
+            smooth_colour(a, b, x, BLACK, data.seams);
+            smooth_colour(a, b, x, RED, data.seams);
+        }
     }
 }
 

@@ -24,6 +24,9 @@ struct MultigridOptions {
     int smoothing_sweeps = 2;      ///< red–black Gauss–Seidel sweeps before and after (≥ 1)
     int coarsest_sweeps = 40;      ///< symmetric sweeps on the coarsest level (≥ 1)
     int coarsest_max_cells = 512;  ///< stop coarsening at or below this many cells (≥ 1)
+    /// Without periodic axes, run a red and a black half sweep in one pass over memory (plane
+    /// k's first colour, then plane k−1's second): the same result, bit for bit.
+    bool pipelined_sweeps = true;
 
     /// Throws std::invalid_argument naming the field when out of range.
     void validate() const;
