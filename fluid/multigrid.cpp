@@ -381,75 +381,121 @@ void smooth_pair(const PoissonMatrix& a, const std::vector<double>& b, std::vect
     });
 }
 
-/// coarse_b = Pᵀ fine_r on active coarse cells.
+/// coarse_b = Pᵀ fine_r on active coarse cells, one axis at a time (P is a tensor product):
+/// along x into `along_x` (coarse x, fine y and z), along y into `along_xy`, then along z.
 void restrict_residual(const AxisTransfer* t, const PoissonMatrix& fine,
                        const std::vector<double>& fine_r, const PoissonMatrix& coarse,
-                       std::vector<double>& coarse_b) {
+                       std::vector<double>& coarse_b, std::vector<double>& along_x,
+                       std::vector<double>& along_xy) {
+    const int fj = fine.nj(), fk = fine.nk();
     const int ci = coarse.ni(), cj = coarse.nj(), ck = coarse.nk();
-    tbb::parallel_for(tbb::blocked_range<int>(0, ck), [&](const tbb::blocked_range<int>& range) {
-        for (int kk = range.begin(); kk != range.end(); ++kk) {
-            for (int jj = 0; jj < cj; ++jj) {
+    const auto ci_s = static_cast<std::size_t>(ci);
+    const std::size_t fi_s = static_cast<std::size_t>(fine.ni());
+    along_x.resize(ci_s * fj * fk);
+    along_xy.resize(ci_s * cj * fk);
+    tbb::parallel_for(tbb::blocked_range<int>(0, fk), [&](const tbb::blocked_range<int>& range) {
+        for (int k = range.begin(); k != range.end(); ++k)
+            for (int j = 0; j < fj; ++j) {
+                const std::size_t row = static_cast<std::size_t>(k) * fj + j;
+                const double* in = fine_r.data() + row * fi_s;
+                double* out = along_x.data() + row * ci_s;
                 for (int ii = 0; ii < ci; ++ii) {
-                    const std::size_t cc = coarse.diag.index(ii, jj, kk);
-                    if (coarse.diag[cc] <= 0.0) {
-                        coarse_b[cc] = 0.0;
-                        continue;
-                    }
                     double sum = 0.0;
-                    for (int sk = 0; sk < t[2].restrict_count[kk]; ++sk) {
-                        const std::size_t ok = static_cast<std::size_t>(kk) * MAX_RESTRICT + sk;
-                        const int k = t[2].restrict_cell[ok];
-                        const double wk = t[2].restrict_weight[ok];
-                        for (int sj = 0; sj < t[1].restrict_count[jj]; ++sj) {
-                            const std::size_t oj = static_cast<std::size_t>(jj) * MAX_RESTRICT + sj;
-                            const int j = t[1].restrict_cell[oj];
-                            const double wjk = wk * t[1].restrict_weight[oj];
-                            const std::size_t row = fine.diag.index(0, j, k);
-                            for (int si = 0; si < t[0].restrict_count[ii]; ++si) {
-                                const std::size_t oi =
-                                    static_cast<std::size_t>(ii) * MAX_RESTRICT + si;
-                                sum += wjk * t[0].restrict_weight[oi] *
-                                       fine_r[row + t[0].restrict_cell[oi]];
-                            }
-                        }
-                    }
-                    coarse_b[cc] = sum;
+                    const std::size_t o = static_cast<std::size_t>(ii) * MAX_RESTRICT;
+                    for (int s = 0; s < t[0].restrict_count[ii]; ++s)
+                        sum += t[0].restrict_weight[o + s] * in[t[0].restrict_cell[o + s]];
+                    out[ii] = sum;
                 }
             }
+    });
+    tbb::parallel_for(tbb::blocked_range<int>(0, fk), [&](const tbb::blocked_range<int>& range) {
+        for (int k = range.begin(); k != range.end(); ++k)
+            for (int jj = 0; jj < cj; ++jj) {
+                double* out = along_xy.data() + (static_cast<std::size_t>(k) * cj + jj) * ci_s;
+                std::fill(out, out + ci, 0.0);
+                const std::size_t o = static_cast<std::size_t>(jj) * MAX_RESTRICT;
+                for (int s = 0; s < t[1].restrict_count[jj]; ++s) {
+                    const double w = t[1].restrict_weight[o + s];
+                    const double* in =
+                        along_x.data() +
+                        (static_cast<std::size_t>(k) * fj + t[1].restrict_cell[o + s]) * ci_s;
+                    for (int ii = 0; ii < ci; ++ii)
+                        out[ii] += w * in[ii];
+                }
+            }
+    });
+    const std::size_t plane = ci_s * cj;
+    tbb::parallel_for(tbb::blocked_range<int>(0, ck), [&](const tbb::blocked_range<int>& range) {
+        for (int kk = range.begin(); kk != range.end(); ++kk) {
+            double* out = coarse_b.data() + static_cast<std::size_t>(kk) * plane;
+            std::fill(out, out + plane, 0.0);
+            const std::size_t o = static_cast<std::size_t>(kk) * MAX_RESTRICT;
+            for (int s = 0; s < t[2].restrict_count[kk]; ++s) {
+                const double w = t[2].restrict_weight[o + s];
+                const double* in =
+                    along_xy.data() + static_cast<std::size_t>(t[2].restrict_cell[o + s]) * plane;
+                for (std::size_t p = 0; p < plane; ++p)
+                    out[p] += w * in[p];
+            }
+            const double* d = coarse.diag.data() + static_cast<std::size_t>(kk) * plane;
+            for (std::size_t p = 0; p < plane; ++p)
+                if (d[p] <= 0.0)
+                    out[p] = 0.0;
         }
     });
 }
 
-/// fine_x += P coarse_x on active fine cells.
+/// fine_x += P coarse_x on active fine cells, one axis at a time: along x into `along_x` (fine
+/// x, coarse y and z), along y into `along_xy`, then along z.
 void prolong_add(const AxisTransfer* t, const PoissonMatrix& coarse,
                  const std::vector<double>& coarse_x, const PoissonMatrix& fine,
-                 std::vector<double>& fine_x) {
+                 std::vector<double>& fine_x, std::vector<double>& along_x,
+                 std::vector<double>& along_xy) {
     const int fi = fine.ni(), fj = fine.nj(), fk = fine.nk();
+    const int cj = coarse.nj(), ck = coarse.nk();
+    const auto fi_s = static_cast<std::size_t>(fi);
+    const auto ci_s = static_cast<std::size_t>(coarse.ni());
+    along_x.resize(fi_s * cj * ck);
+    along_xy.resize(fi_s * fj * ck);
+    tbb::parallel_for(tbb::blocked_range<int>(0, ck), [&](const tbb::blocked_range<int>& range) {
+        for (int kk = range.begin(); kk != range.end(); ++kk)
+            for (int jj = 0; jj < cj; ++jj) {
+                const std::size_t row = static_cast<std::size_t>(kk) * cj + jj;
+                const double* in = coarse_x.data() + row * ci_s;
+                double* out = along_x.data() + row * fi_s;
+                for (int i = 0; i < fi; ++i)
+                    out[i] = t[0].prolong_weight[0][i] * in[t[0].prolong_cell[0][i]] +
+                             t[0].prolong_weight[1][i] * in[t[0].prolong_cell[1][i]];
+            }
+    });
+    tbb::parallel_for(tbb::blocked_range<int>(0, ck), [&](const tbb::blocked_range<int>& range) {
+        for (int kk = range.begin(); kk != range.end(); ++kk)
+            for (int j = 0; j < fj; ++j) {
+                const double w0 = t[1].prolong_weight[0][j], w1 = t[1].prolong_weight[1][j];
+                const double* in0 =
+                    along_x.data() +
+                    (static_cast<std::size_t>(kk) * cj + t[1].prolong_cell[0][j]) * fi_s;
+                const double* in1 =
+                    along_x.data() +
+                    (static_cast<std::size_t>(kk) * cj + t[1].prolong_cell[1][j]) * fi_s;
+                double* out = along_xy.data() + (static_cast<std::size_t>(kk) * fj + j) * fi_s;
+                for (int i = 0; i < fi; ++i)
+                    out[i] = w0 * in0[i] + w1 * in1[i];
+            }
+    });
+    const std::size_t plane = fi_s * fj;
     tbb::parallel_for(tbb::blocked_range<int>(0, fk), [&](const tbb::blocked_range<int>& range) {
         for (int k = range.begin(); k != range.end(); ++k) {
-            for (int j = 0; j < fj; ++j) {
-                for (int i = 0; i < fi; ++i) {
-                    const std::size_t c = fine.diag.index(i, j, k);
-                    if (fine.diag[c] <= 0.0) {
-                        continue;
-                    }
-                    double sum = 0.0;
-                    for (int sk = 0; sk < 2; ++sk) {
-                        const double wk = t[2].prolong_weight[sk][k];
-                        const int kk = t[2].prolong_cell[sk][k];
-                        for (int sj = 0; sj < 2; ++sj) {
-                            const double wjk = wk * t[1].prolong_weight[sj][j];
-                            const int jj = t[1].prolong_cell[sj][j];
-                            const std::size_t row = coarse.diag.index(0, jj, kk);
-                            for (int si = 0; si < 2; ++si) {
-                                sum += wjk * t[0].prolong_weight[si][i] *
-                                       coarse_x[row + t[0].prolong_cell[si][i]];
-                            }
-                        }
-                    }
-                    fine_x[c] += sum;
-                }
-            }
+            const double w0 = t[2].prolong_weight[0][k], w1 = t[2].prolong_weight[1][k];
+            const double* in0 =
+                along_xy.data() + static_cast<std::size_t>(t[2].prolong_cell[0][k]) * plane;
+            const double* in1 =
+                along_xy.data() + static_cast<std::size_t>(t[2].prolong_cell[1][k]) * plane;
+            const double* d = fine.diag.data() + static_cast<std::size_t>(k) * plane;
+            double* out = fine_x.data() + static_cast<std::size_t>(k) * plane;
+            for (std::size_t p = 0; p < plane; ++p)
+                if (d[p] > 0.0)
+                    out[p] += w0 * in0[p] + w1 * in1[p];
         }
     });
 }
@@ -537,9 +583,9 @@ void MultigridPreconditioner::cycle(std::size_t level, const std::vector<double>
     a.residual(x, b, data.r);
     const PoissonMatrix& coarse = level_matrix(level + 1);
     const Level& next = m_levels[level + 1];
-    restrict_residual(data.transfer, a, data.r, coarse, next.b);
+    restrict_residual(data.transfer, a, data.r, coarse, next.b, data.along_x, data.along_xy);
     cycle(level + 1, next.b, next.x);
-    prolong_add(data.transfer, coarse, next.x, a, x);
+    prolong_add(data.transfer, coarse, next.x, a, x, data.along_x, data.along_xy);
     for (int sweep = 0; sweep < m_options.smoothing_sweeps; ++sweep) {
         if (pipelined) {
             smooth_pair(a, b, x, BLACK, false);

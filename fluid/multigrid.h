@@ -70,6 +70,8 @@ private:
         mutable std::vector<double> x;  ///< correction on this level (coarse levels only)
         mutable std::vector<double> b;  ///< right-hand side on this level (coarse levels only)
         mutable std::vector<double> r;  ///< residual scratch
+        /// the transfers' scratch: after their x pass and after their x and y passes
+        mutable std::vector<double> along_x, along_xy;
         AxisTransfer transfer[3];       ///< to the next coarser level
         /// x on the seam planes of periodic axes during a half sweep (smoother scratch)
         mutable SeamPlanes seams;
