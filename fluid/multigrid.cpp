@@ -255,6 +255,25 @@ void smooth_plane(const PoissonMatrix& a, const std::vector<double>& b, std::vec
     const bool px = Wrap && a.periodic[0], py = Wrap && a.periodic[1], pz = Wrap && a.periodic[2];
     for (int j = 0; j < nj; ++j) {
         const std::size_t row = sk * k + sj * j;
+        if (!Wrap && j > 0 && j + 1 < nj && k > 0 && k + 1 < nk) {
+            // A row inside the box along y and z: past its ends the couplings are zero (off_x
+            // is 0 at the far end of a bounded axis, the previous row's last included) and the
+            // cells read there lie inside the array, so the x-neighbours need no test.
+            for (int i = (j + k + colour) % 2; i < ni; i += 2) {
+                const std::size_t c = row + i;
+                if (a_d[c] <= 0.0)
+                    continue;
+                double sum = bv[c];
+                sum -= a_x[c] * xv[c + 1];
+                sum -= a_x[c - 1] * xv[c - 1];
+                sum -= a_y[c] * xv[c + sj];
+                sum -= a_y[c - sj] * xv[c - sj];
+                sum -= a_z[c] * xv[c + sk];
+                sum -= a_z[c - sk] * xv[c - sk];
+                xv[c] = sum / a_d[c];
+            }
+            continue;
+        }
         for (int i = (j + k + colour) % 2; i < ni; i += 2) {
             const std::size_t c = row + i;
             if (a_d[c] <= 0.0) {

@@ -217,65 +217,102 @@ void ViscousOperator::set_edge_weights(const BoundaryOptions& walls, const Array
         const int a = (c + 1) % 3;
         const int b = (c + 2) % 3;
         Array3<double>& weight = m_edge_weight[c];
-        for (int k = 0; k < weight.nk(); ++k) {
-            for (int j = 0; j < weight.nj(); ++j) {
-                for (int i = 0; i < weight.ni(); ++i) {
-                    const Index3 e = {i, j, k};
-                    double fraction = 1.0;
-                    bool free_slip = false;
-                    bool copy = false;  // the seam's edge at n, a copy of the one at 0
-                    for (int axis : {a, b}) {
-                        if (periodic(axis)) {
-                            copy |= e[axis] == m_n[axis];
-                            continue;
+        // Cell-array steps along a and b: an edge inside the box along both has its 4 cells at
+        // its own cell index less 0 or 1 step along each.
+        const std::size_t step_a = a == 0 ? 1 : (a == 1 ? m_mu.ni() : m_mu.ni() * m_mu.nj());
+        const std::size_t step_b = b == 0 ? 1 : (b == 1 ? m_mu.ni() : m_mu.ni() * m_mu.nj());
+        // The 4 cells in for_each_edge_cell()'s order (so the sums are the same).
+        const std::array<std::size_t, 4> around = {step_a + step_b, step_a, step_b, 0};
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, weight.nk()), [&](const tbb::blocked_range<int>& r) {
+                for (int k = r.begin(); k != r.end(); ++k) {
+                    for (int j = 0; j < weight.nj(); ++j) {
+                        for (int i = 0; i < weight.ni(); ++i) {
+                            const Index3 e = {i, j, k};
+                            if (e[a] > 0 && e[a] < m_n[a] && e[b] > 0 && e[b] < m_n[b]) {
+                                // Inside the box: whole dual cell, no wall, no seam.
+                                const std::size_t cell = m_mu.index(i, j, k);
+                                if (m_fraction_weights || m_pointwise_edges) {
+                                    double phi_sum = 0.0;
+                                    for (std::size_t back : around)
+                                        phi_sum += phi[cell - back];
+                                    const double phi_edge = phi_sum / 4;
+                                    weight(i, j, k) =
+                                        SHEAR_WEIGHT *
+                                        (m_pointwise_edges
+                                             ? (is_liquid(phi_edge) ? phases.mu_liquid : m_mu_gas)
+                                             : blended_mu(phases.mu_liquid,
+                                                          control_volume_fraction(phi_edge)));
+                                } else {
+                                    double inverse_sum = 0.0;
+                                    bool inviscid = false;
+                                    for (std::size_t back : around) {
+                                        const double mu = m_mu[cell - back];
+                                        inviscid |= mu == 0.0;
+                                        inverse_sum += inviscid ? 0.0 : 1.0 / mu;
+                                    }
+                                    weight(i, j, k) =
+                                        inviscid ? 0.0 : SHEAR_WEIGHT * 4 / inverse_sum;
+                                }
+                                continue;
+                            }
+                            double fraction = 1.0;
+                            bool free_slip = false;
+                            bool copy = false;  // the seam's edge at n, a copy of the one at 0
+                            for (int axis : {a, b}) {
+                                if (periodic(axis)) {
+                                    copy |= e[axis] == m_n[axis];
+                                    continue;
+                                }
+                                if (e[axis] == 0 || e[axis] == m_n[axis]) {
+                                    fraction *= HALF;  // half the edge's dual cell is outside
+                                    const int side = e[axis] == 0 ? 0 : 1;
+                                    free_slip |= walls.at(axis, side) == BoundaryType::free_slip;
+                                }
+                            }
+                            if (free_slip || copy) {
+                                continue;  // zero shear stress on a free-slip wall
+                            }
+                            if (m_fraction_weights || m_pointwise_edges) {
+                                // Batty & Bridson 2008: the shear term weighted by the liquid
+                                // fraction of the edge's control volume (φ at the edge: the mean of
+                                // its cells), so a traction-free surface sits where φ = 0, not on
+                                // the cell faces next to the void. Pointwise: the μ of the phase
+                                // at the edge's midpoint, by the sign of the same φ.
+                                double phi_sum = 0.0;
+                                int count = 0;
+                                for_each_edge_cell(e, a, b, [&](const Index3& cell) {
+                                    phi_sum += phi(cell[0], cell[1], cell[2]);
+                                    ++count;
+                                });
+                                const double phi_edge = phi_sum / count;
+                                weight(i, j, k) =
+                                    SHEAR_WEIGHT * fraction *
+                                    (m_pointwise_edges
+                                         ? (is_liquid(phi_edge) ? phases.mu_liquid : m_mu_gas)
+                                         : blended_mu(phases.mu_liquid,
+                                                      control_volume_fraction(phi_edge)));
+                                continue;
+                            }
+                            // Harmonic mean of the (up to 4) cells around the edge: exact for the
+                            // shear stress across a layer interface through the edge; 0 next to a
+                            // cell with μ = 0.
+                            double inverse_sum = 0.0;
+                            int count = 0;
+                            bool inviscid = false;
+                            for_each_edge_cell(e, a, b, [&](const Index3& cell) {
+                                const double mu = m_mu(cell[0], cell[1], cell[2]);
+                                inviscid |= mu == 0.0;
+                                inverse_sum += inviscid ? 0.0 : 1.0 / mu;
+                                ++count;
+                            });
+                            if (!inviscid) {
+                                weight(i, j, k) = SHEAR_WEIGHT * fraction * count / inverse_sum;
+                            }
                         }
-                        if (e[axis] == 0 || e[axis] == m_n[axis]) {
-                            fraction *= HALF;  // half the edge's dual cell is outside
-                            const int side = e[axis] == 0 ? 0 : 1;
-                            free_slip |= walls.at(axis, side) == BoundaryType::free_slip;
-                        }
-                    }
-                    if (free_slip || copy) {
-                        continue;  // zero shear stress on a free-slip wall
-                    }
-                    if (m_fraction_weights || m_pointwise_edges) {
-                        // Batty & Bridson 2008: the shear term weighted by the liquid
-                        // fraction of the edge's control volume (φ at the edge: the mean of
-                        // its cells), so a traction-free surface sits where φ = 0, not on
-                        // the cell faces next to the void. Pointwise: the μ of the phase
-                        // at the edge's midpoint, by the sign of the same φ.
-                        double phi_sum = 0.0;
-                        int count = 0;
-                        for_each_edge_cell(e, a, b, [&](const Index3& cell) {
-                            phi_sum += phi(cell[0], cell[1], cell[2]);
-                            ++count;
-                        });
-                        const double phi_edge = phi_sum / count;
-                        weight(i, j, k) =
-                            SHEAR_WEIGHT * fraction *
-                            (m_pointwise_edges
-                                 ? (is_liquid(phi_edge) ? phases.mu_liquid : m_mu_gas)
-                                 : blended_mu(phases.mu_liquid, control_volume_fraction(phi_edge)));
-                        continue;
-                    }
-                    // Harmonic mean of the (up to 4) cells around the edge: exact for the
-                    // shear stress across a layer interface through the edge; 0 next to a
-                    // cell with μ = 0.
-                    double inverse_sum = 0.0;
-                    int count = 0;
-                    bool inviscid = false;
-                    for_each_edge_cell(e, a, b, [&](const Index3& cell) {
-                        const double mu = m_mu(cell[0], cell[1], cell[2]);
-                        inviscid |= mu == 0.0;
-                        inverse_sum += inviscid ? 0.0 : 1.0 / mu;
-                        ++count;
-                    });
-                    if (!inviscid) {
-                        weight(i, j, k) = SHEAR_WEIGHT * fraction * count / inverse_sum;
                     }
                 }
-            }
-        }
+            });
     }
 }
 
