@@ -53,6 +53,24 @@ void apply_kernel(const PoissonMatrix& a, const std::vector<double>& x, std::vec
         for (int k = range.begin(); k != range.end(); ++k) {
             for (int j = 0; j < n_j; ++j) {
                 const std::size_t row = sk * k + sj * j;
+                if (!Wrap && j > 0 && j + 1 < n_j && k > 0 && k + 1 < n_k) {
+                    // A row inside the box along y and z: past its ends the couplings are zero
+                    // (off_x is 0 at the far end of a bounded axis, the previous row's last
+                    // included) and the cells read there lie inside the array: no tests, so
+                    // the loop vectorises.
+                    for (int i = 0; i < n_i; ++i) {
+                        const std::size_t c = row + i;
+                        double sum = a_d[c] * xv[c];
+                        sum += a_x[c] * xv[c + 1];
+                        sum += a_x[c - 1] * xv[c - 1];
+                        sum += a_y[c] * xv[c + sj];
+                        sum += a_y[c - sj] * xv[c - sj];
+                        sum += a_z[c] * xv[c + sk];
+                        sum += a_z[c - sk] * xv[c - sk];
+                        yv[c] = a_d[c] > 0.0 ? sum : 0.0;
+                    }
+                    continue;
+                }
                 for (int i = 0; i < n_i; ++i) {
                     const std::size_t c = row + i;
                     if (a_d[c] <= 0.0) {
