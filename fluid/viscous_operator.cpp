@@ -471,7 +471,42 @@ void ViscousOperator::stress_divergence(std::vector<double>& y) const {
                 for (int k = r.begin(); k != r.end(); ++k) {
                     for (int j = 0; j < dims[1]; ++j) {
                         const std::size_t face_row = face_flat(a, {0, j, k});
+                        // The faces of the row whose cells, below and above, and edges, below
+                        // and above along both other axes, are all inside the box: no seam,
+                        // wall or outflow to treat (i in [fast_begin, fast_end)).
+                        const Index3 row = {0, j, k};
+                        bool inside = true;
+                        for (int axis = 1; axis < 3; ++axis) {
+                            const int limit = axis == a ? m_n[a] - 1 : m_n[axis] - 2;
+                            inside = inside && row[axis] >= 1 && row[axis] <= limit;
+                        }
+                        const int fast_begin = inside ? 1 : dims[0];
+                        const int fast_end =
+                            inside ? std::max(fast_begin, a == 0 ? m_n[0] : m_n[0] - 1) : dims[0];
+                        const std::size_t cell_row =
+                            static_cast<std::size_t>(m_n[0]) *
+                            (static_cast<std::size_t>(j) + static_cast<std::size_t>(m_n[1]) * k);
+                        const Array3<double>& tau0 = m_shear_stress[3 - a - other[0]];
+                        const Array3<double>& tau1 = m_shear_stress[3 - a - other[1]];
+                        const std::size_t tau0_row = tau0.index(0, j, k);
+                        const std::size_t tau1_row = tau1.index(0, j, k);
+                        for (int i = fast_begin; i < fast_end; ++i) {
+                            // Same operations, in the same order, as the general case below.
+                            const std::size_t cell = cell_row + static_cast<std::size_t>(i);
+                            double sum = 0.0;
+                            sum += sigma[cell - cell_step] * inv_dx;
+                            sum -= sigma[cell] * inv_dx;
+                            const std::size_t below0 = tau0_row + static_cast<std::size_t>(i);
+                            sum += tau0[below0] * inv_dx + tau0[below0 + edge_step[0]] * -inv_dx;
+                            const std::size_t below1 = tau1_row + static_cast<std::size_t>(i);
+                            sum += tau1[below1] * inv_dx + tau1[below1 + edge_step[1]] * -inv_dx;
+                            y[face_row + i] = sum;
+                        }
                         for (int i = 0; i < dims[0]; ++i) {
+                            if (i == fast_begin)
+                                i = fast_end;  // done above
+                            if (i >= dims[0])
+                                break;
                             const Index3 f = {i, j, k};
                             if (!solvable(a, f))
                                 continue;
