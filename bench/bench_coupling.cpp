@@ -23,7 +23,10 @@
 //
 // Run: bench_coupling [--benchmark_filter=Cube/128]
 #include <benchmark/benchmark.h>
+#include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -78,6 +81,55 @@ app::Scene bubble_pair_cube(int cells) {
                                    R"("viscous_pressure": {"preconditioner": ")" + schur + R"("})");
 }
 
+// Memory traffic model of the fluid step's three large phases, in doubles moved (read or
+// written) per cell per step, counted from the kernels in fluid/ for the incremental and split
+// schemes with MacCormack advection, the Jacobi viscous CG and the multigrid pressure PCG. A
+// model (±30 %): it counts each array a kernel streams once, and nothing kept in cache between
+// kernels. Divided by the stream copy bandwidth it gives the time the phase would take if it
+// were bound by memory alone (the "bound" table). The coupled scheme's Uzawa passes are not
+// modelled.
+// Advection: the grid's copy 6; per component its copy 2, the forward pass (the field, u, v, w,
+// forward, lower, upper and their allocation) 10, the fused backward pass (forward, u, v, w, φ0,
+// lower, upper, φ0 out) 8: 6 + 3 × 20 = 66.
+constexpr double ADVECTION_DOUBLES = 66.0;
+// Viscosity per CG iteration (3 face arrays, so 3 doubles per cell per vector): the operator
+// (normal stresses 9, shear stresses 12, their divergence 12, the mass term 12.4), p·q 6, the
+// fused update 24, p = z + βp 9: 84. Per step besides: the operator's build (μ, edge weights,
+// face densities and masks, its scratch) 28, the diagonal 12, u* split and b 64, the first
+// residual 63, the result 15: about 180.
+constexpr double VISCOSITY_ITERATION_DOUBLES = 84.0;
+constexpr double VISCOSITY_STEP_DOUBLES = 180.0;
+// Pressure per PCG iteration: the PCG core 30 (A·p 6, p·q 2, two axpy 6, mean removal of r and
+// z 10, r·r 1, r·z 2, p = z + βp 3) and one V-cycle 50 (finest level: four pipelined red-black
+// pairs 27.5, the residual 9, restriction 2.6, prolongation 4.6, × 8/7 for the coarser levels).
+// Per step besides: the hierarchy 6, the first residual and V-cycle 70, the gradient 12, the
+// divergence check 4, adding the increment and its mean 7: about 100.
+constexpr double PRESSURE_ITERATION_DOUBLES = 80.0;
+constexpr double PRESSURE_STEP_DOUBLES = 100.0;
+constexpr double BYTES_PER_DOUBLE = sizeof(double);
+
+/// STREAM-style copy bandwidth, bytes/s, with `threads` TBB threads: b ← a over two 256 MiB
+/// arrays, the best of 5 (the first touches the pages).
+double stream_copy_bandwidth(int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                              static_cast<std::size_t>(threads));
+    const std::size_t count = std::size_t{1} << 25;
+    std::vector<double> a(count, 1.0), b(count, 0.0);
+    double best = 0.0;
+    for (int repeat = 0; repeat < 5; ++repeat) {
+        PhaseClock clock;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t c = range.begin(); c != range.end(); ++c)
+                                  b[c] = a[c] + static_cast<double>(repeat);
+                          });
+        benchmark::DoNotOptimize(b.data());
+        const double seconds = clock.lap().wall;
+        best = std::max(best, 2.0 * BYTES_PER_DOUBLE * static_cast<double>(count) / seconds);
+    }
+    return best;
+}
+
 /// Phase seconds summed over the timed steps.
 struct PhaseTotals {
     std::vector<std::pair<std::string, PhaseSeconds>> phases;
@@ -110,12 +162,22 @@ struct PhaseTotals {
     }
 };
 
+/// Per benchmark: the iterations per step and the threads, for the traffic model.
+struct ModelInputs {
+    std::string label;
+    double pressure_iterations = 0.0;
+    double viscosity_iterations = 0.0;
+    int threads = 0;                                           ///< 0: TBB's default (all cores)
+    std::vector<std::pair<std::string, double>> measured_cpu;  ///< µs per cell per step
+};
+std::vector<ModelInputs> g_model;
+
 /// µs per cell per step of every benchmark that ran, by phase: {benchmark: {phase: (cpu, wall)}}.
 std::vector<std::pair<std::string, std::vector<std::pair<std::string, std::pair<double, double>>>>>
     g_table;
 
 void coupled_steps(benchmark::State& state, const app::Scene& scene, int warmup_steps,
-                   const std::string& label) {
+                   const std::string& label, int threads = 0) {
     std::unique_ptr<coupling::Simulation> sim =
         std::make_unique<coupling::Simulation>(app::make_fluid_simulation(scene));
     const fluid::MacGrid& grid = sim->fluid().grid();
@@ -148,6 +210,14 @@ void coupled_steps(benchmark::State& state, const app::Scene& scene, int warmup_
     state.counters["dt_s"] = dt / n;
     state.counters["pcg_its"] = static_cast<double>(pressure_iterations) / n;
     state.counters["visc_cg_its"] = static_cast<double>(viscosity_iterations) / n;
+    ModelInputs inputs;
+    inputs.label = label;
+    inputs.pressure_iterations = static_cast<double>(pressure_iterations) / n;
+    inputs.viscosity_iterations = static_cast<double>(viscosity_iterations) / n;
+    inputs.threads = threads;
+    for (const auto& [name, figures] : row)
+        inputs.measured_cpu.emplace_back(name, figures.first);
+    g_model.push_back(std::move(inputs));
     state.counters["passes"] = static_cast<double>(passes) / n;
     state.counters["cells"] = cells;
     state.counters["tris_start"] = initial_triangles;
@@ -174,7 +244,7 @@ void BM_BubblePairCube(benchmark::State& state) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
                               static_cast<std::size_t>(threads));
     coupled_steps(state, bubble_pair_cube(cells), 1,
-                  "cube " + std::to_string(cells) + "^3 " + std::to_string(threads) + "T");
+                  "cube " + std::to_string(cells) + "^3 " + std::to_string(threads) + "T", threads);
 }
 
 const int STEPS = env_int("MENISCUS_BENCH_STEPS", DEFAULT_STEPS);
@@ -206,6 +276,49 @@ void print_table() {
     }
 }
 
+/// The traffic model's time per phase (modelled bytes over the stream copy bandwidth at the
+/// benchmark's thread count) beside the measured CPU time, µs per cell per step. At 2 threads
+/// the bound is wall time and the measured figure CPU time (≈ 2 × wall when both work).
+void print_bandwidth_bound() {
+    if (g_model.empty())
+        return;
+    std::map<int, double> bandwidth;  // by thread count
+    for (const ModelInputs& m : g_model)
+        if (bandwidth.count(m.threads) == 0)
+            bandwidth[m.threads] = stream_copy_bandwidth(
+                m.threads > 0 ? m.threads : tbb::this_task_arena::max_concurrency());
+    std::printf(
+        "\nbandwidth bound (modelled bytes / stream copy bandwidth) beside the measured "
+        "CPU time, µs per cell per step\n%-20s",
+        "phase");
+    for (const ModelInputs& m : g_model)
+        std::printf(" | %-19s", m.label.c_str());
+    std::printf("\n%-20s", "stream copy GB/s");
+    for (const ModelInputs& m : g_model)
+        std::printf(" | %19.1f", bandwidth[m.threads] / 1e9);
+    std::printf("\n");
+    const auto measured = [](const ModelInputs& m, const std::string& phase) {
+        for (const auto& [name, cpu] : m.measured_cpu)
+            if (name == phase)
+                return cpu;
+        return 0.0;
+    };
+    const char* phases[] = {"  advection", "  viscosity", "  pressure_solve"};
+    for (int p = 0; p < 3; ++p) {
+        std::printf("%-20s", phases[p]);
+        for (const ModelInputs& m : g_model) {
+            const double doubles =
+                p == 0 ? ADVECTION_DOUBLES
+                : p == 1
+                    ? VISCOSITY_STEP_DOUBLES + VISCOSITY_ITERATION_DOUBLES * m.viscosity_iterations
+                    : PRESSURE_STEP_DOUBLES + PRESSURE_ITERATION_DOUBLES * m.pressure_iterations;
+            const double bound = 1e6 * doubles * BYTES_PER_DOUBLE / bandwidth[m.threads];
+            std::printf(" | %8.3f / %8.3f", bound, measured(m, phases[p]));
+        }
+        std::printf("\n");
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -215,5 +328,6 @@ int main(int argc, char** argv) {
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();
     print_table();
+    print_bandwidth_bound();
     return 0;
 }
