@@ -19,7 +19,8 @@ constexpr double HALF = 0.5;
 class ClampedSamplers {
 public:
     ClampedSamplers(const std::array<const Array3<double>*, 3>& velocity, double inverse_dx)
-        : m_u(*velocity[0], field_offset(FieldLocation::x_face)),
+        : m_fields(velocity),
+          m_u(*velocity[0], field_offset(FieldLocation::x_face)),
           m_v(*velocity[1], field_offset(FieldLocation::y_face)),
           m_w(*velocity[2], field_offset(FieldLocation::z_face)),
           m_inverse_dx(inverse_dx) {}
@@ -27,6 +28,39 @@ public:
     /// Velocity in cell units per second (m/s ÷ dx) at a point given in cell units.
     Eigen::Vector3d velocity(const Eigen::Vector3d& g) const {
         return m_inverse_dx * Eigen::Vector3d(m_u.value(g), m_v.value(g), m_w.value(g));
+    }
+
+    /// velocity() at sample (i, j, k) of a field at `location`, `g` its position, for a face
+    /// sample that is not on a wall normal to its axis: the face's own component is its sample,
+    /// each other the mean of the 4 around it (trilinear interpolation there, one fraction 0
+    /// and two ½, with fewer operations).
+    Eigen::Vector3d velocity_at_sample(FieldLocation location, int i, int j, int k,
+                                       const Eigen::Vector3d& g) const {
+        const int a = location == FieldLocation::x_face   ? 0
+                      : location == FieldLocation::y_face ? 1
+                      : location == FieldLocation::z_face ? 2
+                                                          : -1;
+        if (a < 0)
+            return velocity(g);
+        const std::array<int, 3> at = {i, j, k};
+        const Array3<double>* fields[3] = {m_fields[0], m_fields[1], m_fields[2]};
+        Eigen::Vector3d result;
+        for (int b = 0; b < 3; ++b) {
+            const Array3<double>& f = *fields[b];
+            if (b == a) {
+                result[b] = f(i, j, k);
+                continue;
+            }
+            // Component b's lattice: the face lies between samples at_a − 1 and at_a along a,
+            // and at_b and at_b + 1 along b.
+            const std::size_t step_a = a == 0 ? 1 : (a == 1 ? f.ni() : f.ni() * f.nj());
+            const std::size_t step_b = b == 0 ? 1 : (b == 1 ? f.ni() : f.ni() * f.nj());
+            std::array<int, 3> first = at;
+            --first[static_cast<std::size_t>(a)];
+            const std::size_t c = f.index(first[0], first[1], first[2]);
+            result[b] = 0.25 * (f[c] + f[c + step_a] + f[c + step_b] + f[c + step_a + step_b]);
+        }
+        return m_inverse_dx * result;
     }
 
     /// A sampler of one advected field.
@@ -46,6 +80,7 @@ public:
     }
 
 private:
+    std::array<const Array3<double>*, 3> m_fields;
     ClampedTrilinear m_u, m_v, m_w;
     double m_inverse_dx;
 };
@@ -56,6 +91,11 @@ public:
     PeriodicSamplers(const std::array<const Array3<double>*, 3>& velocity, double inverse_dx,
                      const Periodicity& periodic)
         : m_velocity(velocity), m_inverse_dx(inverse_dx), m_periodic(periodic) {}
+
+    Eigen::Vector3d velocity_at_sample(FieldLocation, int, int, int,
+                                       const Eigen::Vector3d& g) const {
+        return velocity(g);
+    }
 
     Eigen::Vector3d velocity(const Eigen::Vector3d& g) const {
         return m_inverse_dx *
@@ -186,7 +226,8 @@ void semi_lagrangian(const Samplers& samplers, double dt, FieldLocation location
                         continue;
                     }
                     const Eigen::Vector3d start = Eigen::Vector3d(i, j, k) + offset;
-                    const Eigen::Vector3d mid = start - HALF * dt * samplers.velocity(start);
+                    const Eigen::Vector3d mid =
+                        start - HALF * dt * samplers.velocity_at_sample(location, i, j, k, start);
                     const Eigen::Vector3d departure = start - dt * samplers.velocity(mid);
                     TrilinearSample sample;
                     if (Bounds || !inflows.empty()) {
