@@ -45,11 +45,12 @@ constexpr double GIGA = 1e9;
 constexpr double PCG_CORE_DOUBLES = 30.0;
 // MIC(0): clear z 1, forward sweep 6 (r, pivot, 3 off-diagonals, q), backward sweep 6.
 constexpr double MIC0_DOUBLES = 13.0;
-// Multigrid V-cycle on the finest level (works in place on r and z): the first red half-sweep
-// from zero 3 (diag, b in, x out), 7 more red/black half-sweeps that each stream diag,
-// 3 off-diagonals, b and x in and x out (7), residual 9, restriction 1, prolongation 3 = 65;
-// coarser levels add 1/8 + 1/64 + ... ≈ 1/7.
-constexpr double MULTIGRID_DOUBLES = 65.0 * 8.0 / 7.0;
+// Multigrid V-cycle on the finest level (works in place on r and z): four pipelined red-black
+// pairs (multigrid.h), each streaming diag, 3 off-diagonals, b and x in and x out (7), plus an
+// eighth of that again for the slab-edge planes of their second pass: 31.5; the residual 9; the
+// restriction one axis at a time 2.6 and the prolongation 4.6 (their scratch arrays included) =
+// 47.7; coarser levels add 1/8 + 1/64 + ... ≈ 1/7.
+constexpr double MULTIGRID_DOUBLES = 47.7 * 8.0 / 7.0;
 // Eigen IC-CG, per row: CSR A·p with 7 entries of 8-byte values and 4-byte indices (84 B) plus
 // p and q (16 B); two triangular solves with the IC factor (≈ 4 entries per row each, 96 B,
 // plus 32 B of vectors); CG vector updates and dots (≈ 10 vectors, 80 B): about 308 B.
