@@ -303,6 +303,11 @@ void advect_field(const MacGrid& grid, double dt, FieldLocation location,
                   const AdvectionOptions& options, Array3<double>& field,
                   const BoundaryOptions* boundaries) {
     options.validate();
+    for (int axis = 0; axis < 3; ++axis)
+        if (&field == &grid.velocity(axis))
+            throw std::invalid_argument(
+                "advect_field: the field must not be one of the grid's velocity arrays (it is "
+                "overwritten while they are sampled); advect a copy");
     const std::vector<TangentialInflow> inflows = tangential_inflows(grid, location, boundaries);
     const std::array<const Array3<double>*, 3> velocity = {&grid.u(), &grid.v(), &grid.w()};
     const double inverse_dx = 1.0 / grid.dx();

@@ -38,7 +38,8 @@ struct AdvectionOptions {
 /// [min, max] of the 8 samples around the forward departure point falls back to the plain
 /// semi-Lagrangian value. Wall-normal faces of a face-located field are left unchanged.
 /// `boundaries` (optional): the inflow faces (see the file comment; no effect on cell-centred
-/// fields).
+/// fields). `field` is overwritten while `grid`'s velocities are sampled, so it must not be one
+/// of them (throws std::invalid_argument; advect_velocity() advects copies).
 void advect_field(const MacGrid& grid, double dt, FieldLocation location,
                   const AdvectionOptions& options, Array3<double>& field,
                   const BoundaryOptions* boundaries = nullptr);

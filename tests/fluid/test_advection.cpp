@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "fluid/advection.h"
 
@@ -143,6 +144,20 @@ TEST(FluidAdvection, CorrectionsAreLessDiffusiveThanPlainSemiLagrangian) {
                 error[1], error[2]);
     EXPECT_LT(error[1], 0.5 * error[0]);
     EXPECT_LT(error[2], 0.5 * error[0]);
+}
+
+TEST(FluidAdvection, AdvectingTheGridsOwnVelocityArrayIsRefused) {
+    // The corrected schemes overwrite the field while they sample the grid's velocities: a
+    // velocity array passed as the field would be read half-updated.
+    MacGrid grid(6, 5, 4, 0.1);
+    set_uniform_velocity(grid, Eigen::Vector3d(0.3, -0.2, 0.1));
+    for (int axis = 0; axis < 3; ++axis)
+        EXPECT_THROW(advect_field(grid, 0.05, face_location(axis), {AdvectionScheme::maccormack},
+                                  grid.velocity(axis)),
+                     std::invalid_argument);
+    Array3<double> copy = grid.u();
+    EXPECT_NO_THROW(
+        advect_field(grid, 0.05, FieldLocation::x_face, {AdvectionScheme::maccormack}, copy));
 }
 
 }  // namespace
