@@ -237,6 +237,8 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
         m_volumes->add_correction(velocities, report.dt, pinned);
         clock.lap_into(timings.volume_correction);
     }
+    check_surface_motion(mesh, velocities, report.dt, grid.dx(),
+                         m_fluid.options().time_step.cfl_number);
     report.integrate = m_tracker->integrate(velocities, report.dt, pinned);
     clock.lap_into(timings.tracker);
     if (m_fluid.blocks().distributed())

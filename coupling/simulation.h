@@ -14,6 +14,7 @@
 #include "coupling/interpolate.h"
 #include "coupling/open_boundaries.h"
 #include "coupling/rasterize.h"
+#include "coupling/step_guard.h"
 #include "coupling/surface_tension.h"
 #include "coupling/volume_correction.h"
 #include "fluid/fluid_solver.h"
@@ -135,7 +136,9 @@ public:
     /// Advances by one step of at most `time_left` (s, the time left to the next frame; reported
     /// as StepLimit::frame_end when it binds) and at most `max_dt` (s, a scene's largest step;
     /// reported, like the fluid's own TimeStepOptions::max_dt, as StepLimit::max_dt). Throws
-    /// std::invalid_argument unless both are > 0.
+    /// std::invalid_argument unless both are > 0, and UnstableStep (step_guard.h) when the
+    /// fluid step went unstable: the surface would cross many cells (the state is then that of
+    /// the fluid after the step, the mesh before it).
     SimulationStepReport step(double time_left,
                               double max_dt = std::numeric_limits<double>::infinity());
 

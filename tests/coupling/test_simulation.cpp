@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 namespace meniscus::coupling {
 namespace {
@@ -259,6 +260,38 @@ TEST(Simulation, MergedDropStaysSmooth) {
     std::printf("merged drop, 8 cells per diameter, 20 ms: relative roughness %.3f\n", roughness);
     EXPECT_EQ(components, 1);
     EXPECT_LT(roughness, 1.2);
+}
+
+TEST(StepGuard, AnUnstableStepIsStoppedBeforeTheSurfaceMoves) {
+    // Regression: bubble_merge at 128 cells with implicit tension at 4x and cfl_number 1.25 went
+    // unstable in the merge; vertices crossed many cells in one step and the collision broad
+    // phase's edge-edge pairs grew until the process was killed at 24 GB. The guard names the
+    // speed instead, before the tracker moves.
+    const double dx = 1e-4, dt = 2e-5;
+    const tracker::SurfaceMesh mesh = drops({{Vec3(0.0, 0.0, 0.0), 1e-3}}, dx);
+    const auto n = static_cast<std::size_t>(mesh.num_vertices());
+    // One cell per step everywhere: a stable step.
+    std::vector<Vec3> velocities(n, Vec3(dx / dt, 0.0, 0.0));
+    EXPECT_NO_THROW(check_surface_motion(mesh, velocities, dt, dx, 1.0));
+    // One vertex 20 cells: more than 8 (cfl_number 1), less than 4 × 5 (cfl_number 5).
+    velocities[n / 2] = Vec3(0.0, -20.0 * dx / dt, 0.0);
+    EXPECT_NO_THROW(check_surface_motion(mesh, velocities, dt, dx, 5.0));
+    try {
+        check_surface_motion(mesh, velocities, dt, dx, 1.0);
+        ADD_FAILURE() << "20 cells in one step passed";
+    } catch (const UnstableStep& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("went unstable"), std::string::npos) << what;
+        EXPECT_NE(what.find("would move 20 cells"), std::string::npos) << what;
+        EXPECT_NE(what.find("/fluid/cfl_number"), std::string::npos) << what;
+    }
+    // A NaN velocity is unstable too.
+    velocities[n / 2] = Vec3(std::nan(""), 0.0, 0.0);
+    EXPECT_THROW(check_surface_motion(mesh, velocities, dt, dx, 1.0), UnstableStep);
+    velocities.pop_back();
+    EXPECT_THROW(check_surface_motion(mesh, velocities, dt, dx, 1.0), std::invalid_argument);
+    EXPECT_EQ(unstable_motion_cells(1.0), 8.0);
+    EXPECT_EQ(unstable_motion_cells(5.0), 20.0);
 }
 
 }  // namespace
