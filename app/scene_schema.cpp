@@ -212,6 +212,10 @@ void visit_fields(V& v, CouplingOptions& o) {
     v.integer("subgrid_filter_order", o.simulation.surface_tension.subgrid_filter_order,
               Range::between(1, 3), "",
               "order m of the sub-grid high-pass (I − S)^m; a resolved wave feels ε^m of the damping");
+    v.number("max_curvature_cells", o.simulation.surface_tension.max_curvature_cells,
+             Range::positive(), "1/cells",
+             "largest |κ| a crossed face takes, in 1/Δx (a degenerate vertex's curvature has no "
+             "bound)");
     enum_field(v, "velocity_interpolation", o.simulation.interpolate.method,
                {{"trilinear", coupling::VelocityInterpolation::trilinear},
                 {"quadratic_bspline", coupling::VelocityInterpolation::quadratic_bspline},

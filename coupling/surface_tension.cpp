@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -109,6 +110,7 @@ void remove_volume_change(const SurfaceMesh& mesh, std::vector<Vec3>& velocities
 struct AxisTally {
     long long crossed = 0;
     long long without_triangle = 0;
+    long long limited = 0;
     double min_kappa = std::numeric_limits<double>::infinity();
     double max_kappa = -std::numeric_limits<double>::infinity();
 };
@@ -130,6 +132,9 @@ void SurfaceTensionOptions::validate() const {
         throw std::invalid_argument("subgrid_filter_order: expected an integer in [1, " +
                                     std::to_string(MAX_SUBGRID_FILTER_ORDER) + "], got " +
                                     std::to_string(subgrid_filter_order));
+    if (!(max_curvature_cells > 0.0) || !std::isfinite(max_curvature_cells))
+        throw std::invalid_argument("max_curvature_cells: expected a positive number, got " +
+                                    std::to_string(max_curvature_cells));
 }
 
 std::vector<tracker::Vec3> subgrid_tension_velocities(const tracker::SurfaceMesh& mesh,
@@ -244,6 +249,7 @@ SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const flu
     interface.kappa_v.resize(nx, ny + 1, nz, 0.0);
     interface.kappa_w.resize(nx, ny, nz + 1, 0.0);
     std::array<AxisTally, 3> tallies;
+    const double kappa_limit = options.max_curvature_cells / grid.dx();
     for (int axis = 0; axis < 3; ++axis) {
         fluid::Array3<double>& face_kappa = interface.kappa(axis);
         const int di = axis == 0 ? 1 : 0;
@@ -294,6 +300,11 @@ SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const flu
                                 ++tally.without_triangle;
                                 continue;
                             }
+                            if (std::abs(value) > kappa_limit || !(value == value)) {
+                                // NaN from a degenerate one-ring counts as the limit too.
+                                value = value < 0.0 ? -kappa_limit : kappa_limit;
+                                ++tally.limited;
+                            }
                             face_kappa(i, j, k) = value;
                             tally.min_kappa = std::min(tally.min_kappa, value);
                             tally.max_kappa = std::max(tally.max_kappa, value);
@@ -303,6 +314,7 @@ SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const flu
             [](AxisTally a, const AxisTally& b) {
                 a.crossed += b.crossed;
                 a.without_triangle += b.without_triangle;
+                a.limited += b.limited;
                 a.min_kappa = std::min(a.min_kappa, b.min_kappa);
                 a.max_kappa = std::max(a.max_kappa, b.max_kappa);
                 return a;
@@ -313,6 +325,7 @@ SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const flu
     for (const AxisTally& tally : tallies) {
         result.crossed_faces += tally.crossed;
         result.faces_without_triangle += tally.without_triangle;
+        result.limited_faces += tally.limited;
         min_kappa = std::min(min_kappa, tally.min_kappa);
         max_kappa = std::max(max_kappa, tally.max_kappa);
     }

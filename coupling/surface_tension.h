@@ -54,6 +54,12 @@ struct SurfaceTensionOptions {
     /// −4.14 % with m = 2; drop_merge's surface after the merge: rms dihedral angle 0.108 and
     /// 0.122 rad at frame 20 (a smooth sphere of its edge length: 0.09–0.12).
     int subgrid_filter_order = 2;
+    /// The largest |κ| a face takes, in 1/Δx (> 0): 8 is the mean curvature 2/r of a sphere of
+    /// a quarter cell's radius, finer than anything the grid resolves. A vertex whose one-ring
+    /// degenerates (zero area) has a cotangent curvature without bound; regression: 2.4e14 1/m
+    /// (Δx = 7.8e-5 m) in bubble_merge at 128 cells just after the merge, a pressure jump that
+    /// set the gas moving at 3e9 m/s.
+    double max_curvature_cells = 8.0;
     void validate() const;  ///< throws std::invalid_argument naming the field
 };
 
@@ -63,6 +69,8 @@ struct SurfaceTensionResult {
     /// Crossed faces neither of whose cells had a closest triangle (κ left 0; a band that is
     /// too thin or a rasterization that does not belong to this mesh).
     long long faces_without_triangle = 0;
+    /// Crossed faces whose κ was limited to ±max_curvature_cells/Δx.
+    long long limited_faces = 0;
     double min_kappa = 0.0;       ///< over the crossed faces, 1/m (0 when none)
     double max_kappa = 0.0;       ///< over the crossed faces, 1/m (0 when none)
     double vertex_seconds = 0.0;  ///< vertex curvature and smoothing, wall clock

@@ -495,6 +495,33 @@ TEST(SurfaceTension, StaticDropThroughTheFluidSolverHasTheLaplaceJump) {
     }
 }
 
+TEST(SurfaceTension, FaceCurvatureIsLimitedToWhatTheGridCanHold) {
+    // Regression: in bubble_merge at 128 cells, just after the merge, a vertex whose one-ring had
+    // degenerated gave a face κ of 2.4e14 1/m (Δx = 7.8e-5 m); its pressure jump set the gas
+    // moving at 3e9 m/s. Faces now hold at most max_curvature_cells/Δx. A sphere of 1.5 cells'
+    // radius (κ = 1.33/Δx) is below the default limit, and limited to exactly 1/Δx at 1.
+    const int n = 16;
+    const double dx = 1.0 / n;
+    const fluid::MacGrid grid(n, n, n, dx);
+    const double radius = 1.5 * dx;
+    const tracker::SurfaceMesh mesh = sphere_mesh(Vector3d::Constant(8.5 * dx), radius, 0.3 * dx);
+    SurfaceTensionResult result;
+    const fluid::InterfaceInput free = interface_from_mesh(mesh, grid, {}, {}, &result);
+    ASSERT_GT(result.crossed_faces, 0);
+    EXPECT_EQ(result.limited_faces, 0);
+    EXPECT_LT(sphere_curvature_error(free, 2.0 / radius).mean, 0.1);
+    SurfaceTensionOptions limited_options;
+    limited_options.max_curvature_cells = 1.0;
+    const fluid::InterfaceInput limited =
+        interface_from_mesh(mesh, grid, {}, limited_options, &result);
+    EXPECT_EQ(result.limited_faces, result.crossed_faces);
+    EXPECT_DOUBLE_EQ(result.max_kappa, 1.0 / dx);
+    EXPECT_DOUBLE_EQ(result.min_kappa, 1.0 / dx);
+    EXPECT_NEAR(sphere_curvature_error(limited, 1.0 / dx).max, 0.0, 1e-12);
+    limited_options.max_curvature_cells = 0.0;
+    EXPECT_THROW(limited_options.validate(), std::invalid_argument);
+}
+
 TEST(SurfaceTension, InvalidOptionsAndMismatchedRasterAreRejected) {
     SurfaceTensionOptions options;
     options.smoothing_passes = -1;
