@@ -583,36 +583,31 @@ void MultigridPreconditioner::cycle(std::size_t level, const std::vector<double>
         }
         return;
     }
-    // Without periodic axes two half sweeps take one pass (smooth_pair()).
+    // Two half sweeps, `first` then the other colour (`from_zero`: the first from x = 0, red);
+    // without periodic axes in one pass over memory (smooth_pair()).
     const bool pipelined = m_options.pipelined_sweeps && !a.any_periodic();
-    if (pipelined) {
-        smooth_pair(a, b, x, RED, true);
-    } else {
-        first_red_from_zero(a, b, x);
-        smooth_colour(a, b, x, BLACK, data.seams);
-    }
-    for (int sweep = 1; sweep < m_options.smoothing_sweeps; ++sweep) {
+    const auto sweep_pair = [&](int first, bool from_zero) {
         if (pipelined) {
-            smooth_pair(a, b, x, RED, false);
-        } else {
-            smooth_colour(a, b, x, RED, data.seams);
-            smooth_colour(a, b, x, BLACK, data.seams);
+            smooth_pair(a, b, x, first, from_zero);
+            return;
         }
-    }
+        if (from_zero)
+            first_red_from_zero(a, b, x);
+        else
+            smooth_colour(a, b, x, first, data.seams);
+        smooth_colour(a, b, x, 1 - first, data.seams);
+    };
+    sweep_pair(RED, true);
+    for (int sweep = 1; sweep < m_options.smoothing_sweeps; ++sweep)
+        sweep_pair(RED, false);
     a.residual(x, b, data.r);
     const PoissonMatrix& coarse = level_matrix(level + 1);
     const Level& next = m_levels[level + 1];
     restrict_residual(data.transfer, a, data.r, coarse, next.b, data.along_x, data.along_xy);
     cycle(level + 1, next.b, next.x);
     prolong_add(data.transfer, coarse, next.x, a, x, data.along_x, data.along_xy);
-    for (int sweep = 0; sweep < m_options.smoothing_sweeps; ++sweep) {
-        if (pipelined) {
-            smooth_pair(a, b, x, BLACK, false);
-        } else {
-            smooth_colour(a, b, x, BLACK, data.seams);
-            smooth_colour(a, b, x, RED, data.seams);
-        }
-    }
+    for (int sweep = 0; sweep < m_options.smoothing_sweeps; ++sweep)
+        sweep_pair(BLACK, false);
 }
 
 void MultigridPreconditioner::apply(const std::vector<double>& r, std::vector<double>& z) const {
