@@ -15,6 +15,21 @@ namespace {
 
 constexpr double HALF = 0.5;
 
+/// The axis whose faces hold a field at `location` (−1 for cell centres).
+int face_axis(FieldLocation location) {
+    switch (location) {
+        case FieldLocation::x_face:
+            return 0;
+        case FieldLocation::y_face:
+            return 1;
+        case FieldLocation::z_face:
+            return 2;
+        case FieldLocation::cell_centre:
+            return -1;
+    }
+    return -1;
+}
+
 /// The samplers of a box without periodic axes: the inlined ClampedTrilinear.
 class ClampedSamplers {
 public:
@@ -36,17 +51,13 @@ public:
     /// and two ½, with fewer operations).
     Eigen::Vector3d velocity_at_sample(FieldLocation location, int i, int j, int k,
                                        const Eigen::Vector3d& g) const {
-        const int a = location == FieldLocation::x_face   ? 0
-                      : location == FieldLocation::y_face ? 1
-                      : location == FieldLocation::z_face ? 2
-                                                          : -1;
+        const int a = face_axis(location);
         if (a < 0)
             return velocity(g);
         const std::array<int, 3> at = {i, j, k};
-        const Array3<double>* fields[3] = {m_fields[0], m_fields[1], m_fields[2]};
         Eigen::Vector3d result;
         for (int b = 0; b < 3; ++b) {
-            const Array3<double>& f = *fields[b];
+            const Array3<double>& f = *m_fields[static_cast<std::size_t>(b)];
             if (b == a) {
                 result[b] = f(i, j, k);
                 continue;
@@ -131,21 +142,6 @@ private:
     double m_inverse_dx;
     const Periodicity& m_periodic;
 };
-
-/// The axis whose faces hold a field at `location` (−1 for cell centres).
-int face_axis(FieldLocation location) {
-    switch (location) {
-        case FieldLocation::x_face:
-            return 0;
-        case FieldLocation::y_face:
-            return 1;
-        case FieldLocation::z_face:
-            return 2;
-        case FieldLocation::cell_centre:
-            return -1;
-    }
-    return -1;
-}
 
 /// Is sample (i, j, k) of a field at `location` on a wall-normal face (kept fixed)? Along a
 /// periodic axis the face at 0 is advected like an interior one and the one at n is its copy
