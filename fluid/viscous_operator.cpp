@@ -223,6 +223,20 @@ void ViscousOperator::set_edge_weights(const BoundaryOptions& walls, const Array
         const std::size_t step_b = b == 0 ? 1 : (b == 1 ? m_mu.ni() : m_mu.ni() * m_mu.nj());
         // The 4 cells in for_each_edge_cell()'s order (so the sums are the same).
         const std::array<std::size_t, 4> around = {step_a + step_b, step_a, step_b, 0};
+        // W_e from the mean φ of the edge's cells (fraction or pointwise weights) and from the
+        // sum of their 1/μ (harmonic weights; 0 when one is inviscid), `fraction` of the edge's
+        // dual cell inside the box.
+        const auto phase_weight = [&](double phi_edge, double fraction) {
+            return SHEAR_WEIGHT * fraction *
+                   (m_pointwise_edges
+                        ? (is_liquid(phi_edge) ? phases.mu_liquid : m_mu_gas)
+                        : blended_mu(phases.mu_liquid, control_volume_fraction(phi_edge)));
+        };
+        const auto harmonic_weight = [&](double inverse_sum, int count, double fraction,
+                                         bool inviscid) {
+            return inviscid ? 0.0 : SHEAR_WEIGHT * fraction * count / inverse_sum;
+        };
+        constexpr int EDGE_CELLS = 4;
         tbb::parallel_for(
             tbb::blocked_range<int>(0, weight.nk()), [&](const tbb::blocked_range<int>& r) {
                 for (int k = r.begin(); k != r.end(); ++k) {
@@ -236,13 +250,7 @@ void ViscousOperator::set_edge_weights(const BoundaryOptions& walls, const Array
                                     double phi_sum = 0.0;
                                     for (std::size_t back : around)
                                         phi_sum += phi[cell - back];
-                                    const double phi_edge = phi_sum / 4;
-                                    weight(i, j, k) =
-                                        SHEAR_WEIGHT *
-                                        (m_pointwise_edges
-                                             ? (is_liquid(phi_edge) ? phases.mu_liquid : m_mu_gas)
-                                             : blended_mu(phases.mu_liquid,
-                                                          control_volume_fraction(phi_edge)));
+                                    weight(i, j, k) = phase_weight(phi_sum / EDGE_CELLS, 1.0);
                                 } else {
                                     double inverse_sum = 0.0;
                                     bool inviscid = false;
@@ -252,7 +260,7 @@ void ViscousOperator::set_edge_weights(const BoundaryOptions& walls, const Array
                                         inverse_sum += inviscid ? 0.0 : 1.0 / mu;
                                     }
                                     weight(i, j, k) =
-                                        inviscid ? 0.0 : SHEAR_WEIGHT * 4 / inverse_sum;
+                                        harmonic_weight(inverse_sum, EDGE_CELLS, 1.0, inviscid);
                                 }
                                 continue;
                             }
@@ -285,13 +293,7 @@ void ViscousOperator::set_edge_weights(const BoundaryOptions& walls, const Array
                                     phi_sum += phi(cell[0], cell[1], cell[2]);
                                     ++count;
                                 });
-                                const double phi_edge = phi_sum / count;
-                                weight(i, j, k) =
-                                    SHEAR_WEIGHT * fraction *
-                                    (m_pointwise_edges
-                                         ? (is_liquid(phi_edge) ? phases.mu_liquid : m_mu_gas)
-                                         : blended_mu(phases.mu_liquid,
-                                                      control_volume_fraction(phi_edge)));
+                                weight(i, j, k) = phase_weight(phi_sum / count, fraction);
                                 continue;
                             }
                             // Harmonic mean of the (up to 4) cells around the edge: exact for the
@@ -306,9 +308,8 @@ void ViscousOperator::set_edge_weights(const BoundaryOptions& walls, const Array
                                 inverse_sum += inviscid ? 0.0 : 1.0 / mu;
                                 ++count;
                             });
-                            if (!inviscid) {
-                                weight(i, j, k) = SHEAR_WEIGHT * fraction * count / inverse_sum;
-                            }
+                            weight(i, j, k) =
+                                harmonic_weight(inverse_sum, count, fraction, inviscid);
                         }
                     }
                 }
