@@ -1,6 +1,7 @@
 #include "coupling/step_guard.h"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace meniscus::coupling {
@@ -29,12 +30,14 @@ void check_surface_motion(const tracker::SurfaceMesh& mesh,
         if (!mesh.vertex_alive(v))
             continue;
         const double speed = velocities[static_cast<std::size_t>(v)].norm();
-        // A NaN speed fails every comparison: it counts as the fastest.
-        if (fastest < 0 || speed > top_speed || !(speed == speed)) {
+        if (std::isnan(speed)) {  // fails every comparison: it counts as the fastest
             fastest = v;
             top_speed = speed;
-            if (!(speed == speed))
-                break;
+            break;
+        }
+        if (fastest < 0 || speed > top_speed) {
+            fastest = v;
+            top_speed = speed;
         }
     }
     const double limit = unstable_motion_cells(cfl_number);

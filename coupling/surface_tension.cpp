@@ -300,7 +300,7 @@ SurfaceTensionResult face_curvatures(const tracker::SurfaceMesh& mesh, const flu
                                 ++tally.without_triangle;
                                 continue;
                             }
-                            if (std::abs(value) > kappa_limit || !(value == value)) {
+                            if (std::abs(value) > kappa_limit || std::isnan(value)) {
                                 // NaN from a degenerate one-ring counts as the limit too.
                                 value = value < 0.0 ? -kappa_limit : kappa_limit;
                                 ++tally.limited;
