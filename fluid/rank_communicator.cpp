@@ -4,13 +4,23 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <system_error>
+#include <vector>
 
 namespace meniscus::fluid {
 
 namespace {
+
+/// The private session directory of a plain run's MPI (ensure_mpi_initialized()), empty when
+/// there is none.
+std::string& session_directory() {
+    static std::string directory;
+    return directory;
+}
 
 void finalize_mpi_at_exit() {
     std::lock_guard<std::mutex> guard(mpi_lock());
@@ -18,6 +28,21 @@ void finalize_mpi_at_exit() {
     MPI_Finalized(&finalized);
     if (!finalized)
         MPI_Finalize();
+    if (!session_directory().empty()) {
+        std::error_code ignored;
+        std::filesystem::remove_all(session_directory(), ignored);
+    }
+}
+
+/// A new directory of its own for this process's MPI session files, under $TMPDIR (or /tmp);
+/// empty when none can be made (Open MPI then uses its default).
+std::string make_session_directory() {
+    const char* tmp = std::getenv("TMPDIR");
+    std::string pattern =
+        std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/meniscus-mpi.XXXXXX";
+    std::vector<char> path(pattern.begin(), pattern.end());
+    path.push_back('\0');
+    return mkdtemp(path.data()) != nullptr ? std::string(path.data()) : std::string();
 }
 
 void check_mpi(int error, const char* call) {
@@ -74,6 +99,12 @@ bool launched_by_mpi_launcher() {
 //   the shared-memory transport would create a segment file.
 // - Open MPI installs handlers for SIGSEGV/SIGBUS/SIGFPE/SIGABRT that print its own backtrace;
 //   OMPI_MCA_opal_signal="" keeps the program's (and the sanitizers') handling of those signals.
+// - Every singleton keeps its session files under $TMPDIR/ompi.<host>.<uid>/jf.0/1, the same
+//   path for all of them: one that ends removes the directory that one starting beside it is
+//   creating, whose MPI_Init then fails ("A call to mkdir was unable to create the desired
+//   directory ... jf.0/1", seen once in 738 tests run two at a time under load). Each plain run
+//   gets a directory of its own (OMPI_MCA_orte_tmpdir_base, a mkdtemp under $TMPDIR), removed
+//   after MPI_Finalize.
 // All are set with setenv(..., overwrite = 0), so a user's own OMPI_MCA_* settings win, and only
 // when no MPI launcher started the process (under mpirun the launcher's set-up is left alone).
 // MPI_Finalize runs from std::atexit; handlers registered later (hypre's HYPRE_Finalize) run
@@ -95,6 +126,11 @@ void ensure_mpi_initialized() {
             setenv("OMPI_MCA_pml", "ob1", 0);
             setenv("OMPI_MCA_btl", "self", 0);
             setenv("OMPI_MCA_opal_signal", "", 0);
+            if (std::getenv("OMPI_MCA_orte_tmpdir_base") == nullptr) {
+                session_directory() = make_session_directory();
+                if (!session_directory().empty())
+                    setenv("OMPI_MCA_orte_tmpdir_base", session_directory().c_str(), 0);
+            }
         }
         int provided = 0;
         if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS)

@@ -9,6 +9,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <vector>
@@ -71,6 +73,26 @@ TEST(RankCommunicator, WorldSumsAndExchanges) {
         for (double v : from)
             EXPECT_EQ(v, 100.0 * s + world.rank());
     }
+}
+
+/// Regression: every plain run's MPI kept its session files under the same
+/// $TMPDIR/ompi.<host>.<uid>/jf.0/1, which one process removes at its end while another,
+/// started beside it, creates it: that one's MPI_Init failed ("A call to mkdir was unable to
+/// create the desired directory", once in a `./dev.sh test` run two tests at a time). A plain
+/// run now has a directory of its own.
+TEST(RankCommunicator, APlainRunKeepsItsMpiSessionFilesInADirectoryOfItsOwn) {
+    const RankCommunicator world = ranks();
+    if (launched_by_mpi_launcher())
+        GTEST_SKIP() << "under mpirun the launcher's set-up is left alone";
+    const char* base = std::getenv("OMPI_MCA_orte_tmpdir_base");
+    ASSERT_NE(base, nullptr);
+    const std::filesystem::path directory(base);
+    EXPECT_EQ(directory.filename().string().rfind("meniscus-mpi.", 0), 0u) << directory;
+    ASSERT_TRUE(std::filesystem::is_directory(directory)) << directory;
+    bool session = false;  // Open MPI's tree, ompi.<host>.<uid>, is inside it
+    for (const auto& entry : std::filesystem::directory_iterator(directory))
+        session = session || entry.path().filename().string().rfind("ompi.", 0) == 0;
+    EXPECT_TRUE(session) << directory;
 }
 
 struct HaloCase {
