@@ -158,4 +158,40 @@ std::shared_ptr<const fluid::SurfaceViscosity> build_surface_viscosity(
     return term;
 }
 
+std::vector<tracker::Vec3> term_vertex_velocities(const tracker::SurfaceMesh& mesh,
+                                                  const fluid::MacGrid& grid,
+                                                  const InterpolateOptions& interpolate,
+                                                  const fluid::BoundaryOptions& walls,
+                                                  const fluid::Array3<double>& phi,
+                                                  double rho_liquid, double rho_gas) {
+    if (phi.ni() != grid.nx() || phi.nj() != grid.ny() || phi.nk() != grid.nz())
+        throw std::invalid_argument("term_vertex_velocities: phi must have the grid's cells");
+    if (!(rho_liquid > 0.0 && rho_gas >= 0.0) || !std::isfinite(rho_liquid) ||
+        !std::isfinite(rho_gas))
+        throw std::invalid_argument(
+            "term_vertex_velocities: rho_liquid must be > 0 and rho_gas >= 0");
+    std::vector<int> vertices;
+    for (int v = 0; v < mesh.num_vertices(); ++v)
+        if (mesh.vertex_alive(v))
+            vertices.push_back(v);
+    RowMatrix sample = vertex_velocity_weights(grid, mesh, vertices, interpolate, walls);
+    weight_by_face_density(sample, grid, phi, rho_liquid, rho_gas);
+    // The flat face vector [u | v | w] the columns index.
+    Eigen::VectorXd faces(sample.cols());
+    Eigen::Index offset = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::vector<double>& u = grid.velocity(axis).storage();
+        faces.segment(offset, static_cast<Eigen::Index>(u.size())) =
+            Eigen::Map<const Eigen::VectorXd>(u.data(), static_cast<Eigen::Index>(u.size()));
+        offset += static_cast<Eigen::Index>(u.size());
+    }
+    const Eigen::VectorXd sampled = sample * faces;
+    std::vector<tracker::Vec3> velocities(static_cast<std::size_t>(mesh.num_vertices()),
+                                          tracker::Vec3::Zero());
+    for (std::size_t p = 0; p < vertices.size(); ++p)
+        velocities[static_cast<std::size_t>(vertices[p])] =
+            sampled.segment<3>(3 * static_cast<Eigen::Index>(p));
+    return velocities;
+}
+
 }  // namespace meniscus::coupling

@@ -215,8 +215,18 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     }
 
     // (4) Grid → mesh.
-    m_vertex_velocities = interpolate_vertex_velocities(m_fluid.grid(), mesh, m_options.interpolate,
-                                                        m_fluid.grid_boundaries());
+    if (m_options.implicit_tension > 0.0 && phases.sigma > 0.0 &&
+        m_fluid.options().mode == fluid::FluidMode::two_phase) {
+        // As the implicit term saw the surface move (implicit_tension.h). (Free-surface gas
+        // faces hold the liquid's velocity extrapolated, not modes of their own: the mesh reads
+        // them as it does without the term.)
+        m_vertex_velocities = term_vertex_velocities(mesh, m_fluid.grid(), m_options.interpolate,
+                                                     m_fluid.grid_boundaries(), m_phi,
+                                                     phases.rho_liquid, phases.rho_gas);
+    } else {
+        m_vertex_velocities = interpolate_vertex_velocities(
+            m_fluid.grid(), mesh, m_options.interpolate, m_fluid.grid_boundaries());
+    }
     if (m_fluid.blocks().distributed())
         combine_rank_velocities(m_vertex_velocities);
     if (boundaries.inflow())

@@ -55,6 +55,8 @@ struct SimulationOptions {
     /// diameter) at 3× the limit grew unstable within 4 ms whether the term sampled the grid as
     /// the one-sided method or trilinearly (max|u| 0.063 and 0.038 m/s against the explicit
     /// run's 0.024); with trilinear ones it stays within the explicit run's 0.025 for 25 ms.
+    /// In two_phase mode the mesh then moves with the term's own density-weighted weights
+    /// (term_vertex_velocities()), not with the plain trilinear vertex velocities.
     double implicit_tension = 0.0;
     /// Which surface stiffness the implicit term uses (implicit_tension.h): `normal` (only
     /// shape-changing motion is damped) or Hysing's `full` (the surface's stretching too, which

@@ -392,10 +392,11 @@ TEST_F(QuickValidation, PartBCasesCarryConvergenceStudies) {
 }
 
 /// Semi-implicit surface tension at 3× the capillary limit against the explicit run, both with
-/// trilinear vertex velocities (issue 36 item 3): measured B4 ω −0.56 % (and its extra damping
-/// about ω²Δt/2: γ 0.78 against 0.05 1/s), B2 ω −1.40 %, B1 Δp −0.003 % with the peak spurious
-/// currents 0.32× the explicit run's (2.9e-3 against 9.3e-3 in max|u|·sqrt(ρD/σ); 2.3× before
-/// the term's sampling was weighted by face density).
+/// trilinear vertex velocities (issue 36 item 3; the normal form, the mesh moved with the term's
+/// weights): measured B4 ω −0.58 % (and its extra damping about ω²Δt/2: γ 0.78 against 0.05
+/// 1/s), B2 ω −1.50 % (−0.10 % with the mesh moved by the plain trilinear velocities), B1 Δp
+/// −0.003 % with the peak spurious currents 0.52× the explicit run's (4.9e-3 against 9.3e-3 in
+/// max|u|·sqrt(ρD/σ); 2.3× before the term's sampling was weighted by face density).
 TEST_F(QuickValidation, PartBImplicitTensionKeepsTheFrequencyAtThreeTimesTheCapillaryStep) {
     const Json& b = s_results["part_b"];
     for (const char* id : {"B1", "B2", "B4"}) {
