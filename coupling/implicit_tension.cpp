@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace meniscus::coupling {
@@ -41,6 +42,17 @@ double face_density(const fluid::MacGrid& grid, const fluid::Array3<double>& phi
     return rho_gas + (rho_liquid - rho_gas) * theta;
 }
 
+/// Throws std::invalid_argument, naming `caller`, unless `phi` has the grid's cells and the
+/// densities weight_by_face_density() reads are valid (ρ_liquid > 0, ρ_gas ≥ 0, both finite).
+void check_density_weighting(const fluid::MacGrid& grid, const fluid::Array3<double>& phi,
+                             double rho_liquid, double rho_gas, const std::string& caller) {
+    if (phi.ni() != grid.nx() || phi.nj() != grid.ny() || phi.nk() != grid.nz())
+        throw std::invalid_argument(caller + ": phi must have the grid's cells");
+    if (!(rho_liquid > 0.0 && rho_gas >= 0.0) || !std::isfinite(rho_liquid) ||
+        !std::isfinite(rho_gas))
+        throw std::invalid_argument(caller + ": rho_liquid must be > 0 and rho_gas >= 0");
+}
+
 /// Scales each row of `sample` by the densities of the faces it reads and rescales it to its
 /// old sum (a row that reads only massless faces is left as it was).
 void weight_by_face_density(RowMatrix& sample, const fluid::MacGrid& grid,
@@ -73,14 +85,8 @@ std::shared_ptr<const fluid::SurfaceViscosity> build_surface_viscosity(
         throw std::invalid_argument("build_surface_viscosity: viscosity must be finite and >= 0");
     if (form != SurfaceTermForm::normal && form != SurfaceTermForm::full)
         throw std::invalid_argument("build_surface_viscosity: unknown form");
-    if (phi) {
-        if (phi->ni() != grid.nx() || phi->nj() != grid.ny() || phi->nk() != grid.nz())
-            throw std::invalid_argument("build_surface_viscosity: phi must have the grid's cells");
-        if (!(rho_liquid > 0.0 && rho_gas >= 0.0) || !std::isfinite(rho_liquid) ||
-            !std::isfinite(rho_gas))
-            throw std::invalid_argument(
-                "build_surface_viscosity: rho_liquid must be > 0 and rho_gas >= 0");
-    }
+    if (phi)
+        check_density_weighting(grid, *phi, rho_liquid, rho_gas, "build_surface_viscosity");
     const Vector3d lo = grid.origin();
     const Vector3d hi = lo + grid.dx() * Vector3d(grid.nx(), grid.ny(), grid.nz());
     const auto inside = [&](const Vector3d& x) {
@@ -164,12 +170,7 @@ std::vector<tracker::Vec3> term_vertex_velocities(const tracker::SurfaceMesh& me
                                                   const fluid::BoundaryOptions& walls,
                                                   const fluid::Array3<double>& phi,
                                                   double rho_liquid, double rho_gas) {
-    if (phi.ni() != grid.nx() || phi.nj() != grid.ny() || phi.nk() != grid.nz())
-        throw std::invalid_argument("term_vertex_velocities: phi must have the grid's cells");
-    if (!(rho_liquid > 0.0 && rho_gas >= 0.0) || !std::isfinite(rho_liquid) ||
-        !std::isfinite(rho_gas))
-        throw std::invalid_argument(
-            "term_vertex_velocities: rho_liquid must be > 0 and rho_gas >= 0");
+    check_density_weighting(grid, phi, rho_liquid, rho_gas, "term_vertex_velocities");
     std::vector<int> vertices;
     for (int v = 0; v < mesh.num_vertices(); ++v)
         if (mesh.vertex_alive(v))

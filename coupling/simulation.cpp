@@ -142,9 +142,9 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     // (An empty mesh — everything left through outflow faces — has no edge length.)
     const tracker::EdgeLengthStats edges = tracker::edge_length_stats(mesh);
     const double h = edges.count > 0 ? std::min(grid.dx(), edges.mean) : grid.dx();
-    const double rho_mean = m_fluid.options().mode == fluid::FluidMode::two_phase
-                                ? 0.5 * (phases.rho_liquid + phases.rho_gas)
-                                : 0.5 * phases.rho_liquid;
+    const bool two_phase = m_fluid.options().mode == fluid::FluidMode::two_phase;
+    const double rho_mean =
+        two_phase ? 0.5 * (phases.rho_liquid + phases.rho_gas) : 0.5 * phases.rho_liquid;
     const double capillary = phases.sigma > 0.0
                                  ? m_options.capillary_safety *
                                        std::sqrt(rho_mean * h * h * h / (2.0 * M_PI * phases.sigma))
@@ -177,9 +177,9 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     fluid::InterfaceInput interface;
     face_curvatures(grid_mesh, grid, raster, m_options.surface_tension, interface);
     interface.phi = std::move(raster.phi);
-    if (m_options.implicit_tension > 0.0 && phases.sigma > 0.0) {
+    const bool implicit_term = m_options.implicit_tension > 0.0 && phases.sigma > 0.0;
+    if (implicit_term) {
         // Sampled by face density (implicit_tension.h); free-surface gas faces carry no mass.
-        const bool two_phase = m_fluid.options().mode == fluid::FluidMode::two_phase;
         interface.surface_viscosity = build_surface_viscosity(
             mesh, grid, m_options.implicit_tension * phases.sigma * report.dt,
             m_options.interpolate, m_fluid.options().boundaries, &interface.phi, phases.rho_liquid,
@@ -215,8 +215,7 @@ SimulationStepReport Simulation::step(double time_left, double max_dt) {
     }
 
     // (4) Grid → mesh.
-    if (m_options.implicit_tension > 0.0 && phases.sigma > 0.0 &&
-        m_fluid.options().mode == fluid::FluidMode::two_phase) {
+    if (implicit_term && two_phase) {
         // As the implicit term saw the surface move (implicit_tension.h). (Free-surface gas
         // faces hold the liquid's velocity extrapolated, not modes of their own: the mesh reads
         // them as it does without the term.)
