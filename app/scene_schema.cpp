@@ -192,6 +192,13 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
                            "coupled: the passes stop once D/(1+D) times the largest "
                            "divergence·Δx of the viscous velocity, over the largest speed, is "
                            "below this (D = νΔt/Δx² of the more diffusive phase)");
+                  r.boolean("local_passes", o.viscous_pressure.local_passes,
+                            "coupled: run the passes on the box of the cells whose own "
+                            "estimate exceeds pass_tolerance (the interface and gas of a water-"
+                            "air flow), grown by pass_margin cells, when it is at most half the "
+                            "grid (one process, no periodic axis, explicit tension)");
+                  r.integer("pass_margin", o.viscous_pressure.pass_margin, Range::between(0, 1000),
+                            "cells", "coupled: cells added on every side of the passes' box");
               });
     v.number("cfl_number", o.time_step.cfl_number, Range::positive(), "cells",
              "cells a fluid particle may cross per step");

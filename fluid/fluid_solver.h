@@ -85,6 +85,13 @@ struct StepResult {
     int passes = 0;
     double pass_change = 0.0;
     bool converged_passes = true;
+    /// coupled: the cells the passes ran on (the whole grid's, or those of their region:
+    /// ViscousPressureOptions::local_passes); 0 without passes.
+    std::size_t pass_cells = 0;
+    /// coupled: of viscosity.iterations and pressure.iterations, those of the passes (on
+    /// pass_cells cells each; the Cahouet–Chabard preconditioner's V-cycles count one each).
+    int pass_viscosity_iterations = 0;
+    int pass_pressure_iterations = 0;
     StepTimings timings;
 };
 
@@ -180,6 +187,7 @@ private:
     Array3<double> m_pressure;
     Array3<double> m_increment;  ///< scratch: the projection's pressure increment δ
     ViscositySolver m_viscosity;
+    ViscositySolver m_region_viscosity;  ///< the coupled scheme's passes on a part of the grid
     std::vector<char> m_was_liquid;  ///< liquid flags of the last step's cells (empty at first)
     double m_time = 0.0;
 };

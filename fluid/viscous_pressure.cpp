@@ -36,6 +36,119 @@ void ViscousPressureOptions::validate() const {
         throw std::invalid_argument("ViscousPressureOptions.max_passes must be at least 1");
     if (!(pass_tolerance > 0.0 && pass_tolerance < 1.0))
         throw std::invalid_argument("ViscousPressureOptions.pass_tolerance must be in (0, 1)");
+    if (pass_margin < 0)
+        throw std::invalid_argument("ViscousPressureOptions.pass_margin must be at least 0");
+}
+
+std::size_t CellBox::size() const {
+    std::size_t n = 1;
+    for (int a = 0; a < 3; ++a)
+        n *= static_cast<std::size_t>(std::max(0, cells(a)));
+    return n;
+}
+
+CellBox CellBox::whole(const Array3<double>& cells) {
+    CellBox box;
+    box.hi = {cells.ni(), cells.nj(), cells.nk()};
+    return box;
+}
+
+CellBox pass_region(const std::vector<double>& r, const Array3<double>& phi,
+                    const PhaseOptions& phases, FluidMode mode, double dt, double dx, double speed,
+                    double tolerance, int margin) {
+    if (r.size() != phi.size())
+        throw std::invalid_argument("pass_region: r and phi differ in size");
+    if (!(speed > 0.0) || !(tolerance > 0.0) || margin < 0)
+        throw std::invalid_argument("pass_region: speed and tolerance must be > 0 and margin >= 0");
+    const bool two_phase = mode == FluidMode::two_phase;
+    const double nu_liquid = phases.mu_liquid / phases.rho_liquid;
+    const double nu_gas = two_phase ? phases.mu_gas / phases.rho_gas : nu_liquid;
+    const double scale = dt / (dx * dx);
+    const auto share = [&](double nu) { return nu * scale / (1.0 + nu * scale); };
+    // A cell needs passes when |r_c| exceeds this (the share of its most diffusive phase).
+    const double limit_liquid = tolerance * speed / (share(nu_liquid) * dx);
+    const double limit_gas = tolerance * speed / (share(std::max(nu_liquid, nu_gas)) * dx);
+    CellBox box;
+    box.lo = {phi.ni(), phi.nj(), phi.nk()};
+    box.hi = {0, 0, 0};
+    for (int k = 0; k < phi.nk(); ++k)
+        for (int j = 0; j < phi.nj(); ++j)
+            for (int i = 0; i < phi.ni(); ++i) {
+                const std::size_t c = phi.index(i, j, k);
+                const double magnitude = std::abs(r[c]);
+                if (!(magnitude > std::min(limit_liquid, limit_gas)))
+                    continue;
+                double limit = limit_liquid;
+                if (two_phase && nu_gas > nu_liquid) {
+                    bool gas = !is_liquid(phi[c]);
+                    for (int n = 0; n < 6 && !gas; ++n) {
+                        const int a = i + NEIGHBOURS[n][0], b = j + NEIGHBOURS[n][1],
+                                  d = k + NEIGHBOURS[n][2];
+                        gas = phi.contains(a, b, d) && !is_liquid(phi(a, b, d));
+                    }
+                    if (gas)
+                        limit = limit_gas;
+                }
+                if (!(magnitude > limit))
+                    continue;
+                const std::array<int, 3> cell = {i, j, k};
+                for (std::size_t a = 0; a < 3; ++a) {
+                    box.lo[a] = std::min(box.lo[a], cell[a]);
+                    box.hi[a] = std::max(box.hi[a], cell[a] + 1);
+                }
+            }
+    if (box.hi[0] == 0)
+        return CellBox{};
+    const std::array<int, 3> n = {phi.ni(), phi.nj(), phi.nk()};
+    for (std::size_t a = 0; a < 3; ++a) {
+        box.lo[a] = std::max(0, box.lo[a] - margin);
+        box.hi[a] = std::min(n[a], box.hi[a] + margin);
+    }
+    return box;
+}
+
+InterfaceInput interface_in_box(const InterfaceInput& interface, const CellBox& box) {
+    const Array3<double>& phi = interface.phi;
+    for (int a = 0; a < 3; ++a)
+        if (box.cells(a) <= 0 || box.lo[static_cast<std::size_t>(a)] < 0)
+            throw std::invalid_argument("interface_in_box: the box is empty");
+    if (box.hi[0] > phi.ni() || box.hi[1] > phi.nj() || box.hi[2] > phi.nk())
+        throw std::invalid_argument("interface_in_box: the box is not inside the grid");
+    InterfaceInput sub;
+    sub.phi.resize(box.cells(0), box.cells(1), box.cells(2), 0.0);
+    for (int k = 0; k < box.cells(2); ++k)
+        for (int j = 0; j < box.cells(1); ++j)
+            for (int i = 0; i < box.cells(0); ++i)
+                sub.phi(i, j, k) = phi(box.lo[0] + i, box.lo[1] + j, box.lo[2] + k);
+    for (int axis = 0; axis < 3; ++axis) {
+        std::array<int, 3> n = {box.cells(0), box.cells(1), box.cells(2)};
+        ++n[static_cast<std::size_t>(axis)];
+        const Array3<double>& kappa = interface.kappa(axis);
+        Array3<double>& out = sub.kappa(axis);
+        out.resize(n[0], n[1], n[2], 0.0);
+        for (int k = 0; k < n[2]; ++k)
+            for (int j = 0; j < n[1]; ++j)
+                for (int i = 0; i < n[0]; ++i)
+                    out(i, j, k) = kappa(box.lo[0] + i, box.lo[1] + j, box.lo[2] + k);
+    }
+    return sub;
+}
+
+BoundaryOptions box_boundaries(const BoundaryOptions& whole, const CellBox& box,
+                               const std::array<int, 3>& cells) {
+    BoundaryOptions out = whole;
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::size_t a = static_cast<std::size_t>(axis);
+        const bool reaches[2] = {box.lo[a] == 0, box.hi[a] == cells[a]};
+        for (int side = 0; side < 2; ++side) {
+            if (reaches[side] && !whole.periodic(axis))
+                continue;
+            FaceBoundary cut;
+            cut.type = BoundaryType::outflow;
+            out.face(axis, side) = cut;
+        }
+    }
+    return out;
 }
 
 std::vector<char> liquid_cells(const Array3<double>& phi) {

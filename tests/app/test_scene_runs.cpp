@@ -239,7 +239,8 @@ TEST(FluidScenes, StatsReportTheViscousAndPressureSolves) {
     EXPECT_GT(solves["viscosity"]["iterations_per_step"].get<double>(), 0.0);
     EXPECT_EQ(solves["pressure"]["unconverged_steps"], 0);
     EXPECT_EQ(solves["viscosity"]["unconverged_steps"], 0);
-    EXPECT_LE(solves["viscosity"]["max_residual"].get<double>(), 1e-6);
+    // The coupled scheme's passes solve their viscous impulses to a tenth of pass_tolerance.
+    EXPECT_LE(solves["viscosity"]["max_residual"].get<double>(), 1e-4);
     EXPECT_TRUE(solves.contains("viscous_pressure_passes"));
 }
 
