@@ -96,6 +96,10 @@ void FrameSolves::add(const fluid::StepResult& r) {
     pressure_failures += r.pressure.converged ? 0 : 1;
     viscosity_failures += r.viscosity.converged ? 0 : 1;
     pass_failures += r.converged_passes ? 0 : 1;
+    if (r.passes > 0) {
+        pass_cells += static_cast<double>(r.pass_cells);
+        ++steps_with_passes;
+    }
 }
 
 nlohmann::json FrameSolves::json(long long steps) const {
@@ -111,7 +115,10 @@ nlohmann::json FrameSolves::json(long long steps) const {
             {"viscous_pressure_passes",
              {{"per_step", passes / n},
               {"max_change", pass_change},
-              {"unconverged_steps", pass_failures}}}};
+              {"unconverged_steps", pass_failures},
+              // Cells per step with passes: their region's (local_passes) or the grid's.
+              {"mean_cells",
+               pass_cells / static_cast<double>(std::max<long long>(steps_with_passes, 1))}}}};
 }
 
 std::string FrameSolves::warning(int frame, long long steps) const {

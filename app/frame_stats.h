@@ -58,6 +58,9 @@ struct FrameSolves {
     long long pressure_iterations = 0, viscosity_iterations = 0, passes = 0;
     double pressure_residual = 0.0, viscosity_residual = 0.0, pass_change = 0.0;
     int pressure_failures = 0, viscosity_failures = 0, pass_failures = 0;  ///< steps not converged
+    /// The cells the coupled scheme's passes ran on, summed over the steps that made passes.
+    double pass_cells = 0.0;
+    long long steps_with_passes = 0;
 
     void add(const fluid::StepResult& r);
 
