@@ -328,20 +328,28 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
         // tension (its term lives on the whole grid): else, and when that box is most of the
         // grid, on the whole grid.
         CellBox region = CellBox::whole(m_pressure);
+        // (An open face's ambient phase is decided over the whole face: no box reaches one.)
+        double settled = 0.0;  // the largest estimate of the cells left out
         if (!result.converged_passes && scheme.local_passes && !m_blocks.distributed() &&
             !implicit_tension && !m_grid.periodic()[0] && !m_grid.periodic()[1] &&
-            !m_grid.periodic()[2]) {
+            !m_grid.periodic()[2] && !whole_boundaries.open() && !whole_boundaries.inflow()) {
             const double speed = std::max(m_grid.max_abs_velocity().maxCoeff(), velocity_floor);
-            const CellBox needed = pass_region(r, interface.phi, phases, mode, dt, dx, speed,
-                                               scheme.pass_tolerance, scheme.pass_margin);
-            if (needed.empty())
+            const PassRegion needed = pass_region(r, interface.phi, phases, mode, dt, dx, speed,
+                                                  scheme.pass_tolerance, scheme.pass_margin);
+            if (needed.box.empty()) {
                 result.converged_passes = true;
-            else if (static_cast<double>(needed.size()) <=
-                     MAX_PASS_REGION_SHARE * static_cast<double>(region.size()))
-                region = needed;
+                result.pass_change = needed.settled;
+            } else if (static_cast<double>(needed.box.size()) <=
+                       MAX_PASS_REGION_SHARE * static_cast<double>(region.size())) {
+                region = needed.box;
+                settled = needed.settled;
+            }
         }
         const bool local = !(region == CellBox::whole(m_pressure));
-        result.pass_cells = result.converged_passes ? 0 : region.size();
+        if (!result.converged_passes)
+            result.pass_cells =
+                local ? region.size()
+                      : static_cast<std::size_t>(m_box_cells[0]) * m_box_cells[1] * m_box_cells[2];
         // The pass problem: the whole block's, or the region's copy.
         InterfaceInput region_interface;
         BoundaryOptions region_boundaries;
@@ -369,7 +377,7 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
             const double largest = pass_blocks.max_abs_cells(r, pass_layer);
             const double speed =
                 std::max(m_blocks.max(m_grid.max_abs_velocity().maxCoeff()), velocity_floor);
-            return viscous_share * largest * dx / speed;
+            return std::max(viscous_share * largest * dx / speed, settled);
         };
         PressureSystem system;
         std::unique_ptr<PressureSystemSolver> poisson;  // its preconditioner serves every pass

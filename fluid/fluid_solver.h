@@ -81,7 +81,9 @@ struct StepResult {
     /// coupled: Uzawa–PCG iterations of the step (0 for the other schemes and for inviscid
     /// flow); pass_change: after them (before the final projection), the largest |D u|·Δx over
     /// the velocity scale (the largest face speed, at least |g|Δt), times D/(1 + D) (see
-    /// ViscousPressureOptions::pass_tolerance); converged_passes: it met pass_tolerance.
+    /// ViscousPressureOptions::pass_tolerance; with local passes: over their region, and each
+    /// cell left out by its own estimate, which is at most pass_tolerance); converged_passes: it
+    /// met pass_tolerance.
     int passes = 0;
     double pass_change = 0.0;
     bool converged_passes = true;

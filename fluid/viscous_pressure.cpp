@@ -36,8 +36,8 @@ void ViscousPressureOptions::validate() const {
         throw std::invalid_argument("ViscousPressureOptions.max_passes must be at least 1");
     if (!(pass_tolerance > 0.0 && pass_tolerance < 1.0))
         throw std::invalid_argument("ViscousPressureOptions.pass_tolerance must be in (0, 1)");
-    if (pass_margin < 0)
-        throw std::invalid_argument("ViscousPressureOptions.pass_margin must be at least 0");
+    if (pass_margin < 0 || pass_margin > 1000)
+        throw std::invalid_argument("ViscousPressureOptions.pass_margin must be in [0, 1000]");
 }
 
 std::size_t CellBox::size() const {
@@ -53,9 +53,9 @@ CellBox CellBox::whole(const Array3<double>& cells) {
     return box;
 }
 
-CellBox pass_region(const std::vector<double>& r, const Array3<double>& phi,
-                    const PhaseOptions& phases, FluidMode mode, double dt, double dx, double speed,
-                    double tolerance, int margin) {
+PassRegion pass_region(const std::vector<double>& r, const Array3<double>& phi,
+                       const PhaseOptions& phases, FluidMode mode, double dt, double dx,
+                       double speed, double tolerance, int margin) {
     if (r.size() != phi.size())
         throw std::invalid_argument("pass_region: r and phi differ in size");
     if (!(speed > 0.0) || !(tolerance > 0.0) || margin < 0)
@@ -68,16 +68,22 @@ CellBox pass_region(const std::vector<double>& r, const Array3<double>& phi,
     // A cell needs passes when |r_c| exceeds this (the share of its most diffusive phase).
     const double limit_liquid = tolerance * speed / (share(nu_liquid) * dx);
     const double limit_gas = tolerance * speed / (share(std::max(nu_liquid, nu_gas)) * dx);
-    CellBox box;
+    PassRegion region;
+    CellBox& box = region.box;
     box.lo = {phi.ni(), phi.nj(), phi.nk()};
     box.hi = {0, 0, 0};
+    const double share_liquid = share(nu_liquid);
+    const double share_gas = share(std::max(nu_liquid, nu_gas));
     for (int k = 0; k < phi.nk(); ++k)
         for (int j = 0; j < phi.nj(); ++j)
             for (int i = 0; i < phi.ni(); ++i) {
                 const std::size_t c = phi.index(i, j, k);
                 const double magnitude = std::abs(r[c]);
-                if (!(magnitude > std::min(limit_liquid, limit_gas)))
+                if (!(magnitude > std::min(limit_liquid, limit_gas))) {
+                    region.settled = std::max(
+                        region.settled, std::max(share_liquid, share_gas) * magnitude * dx / speed);
                     continue;
+                }
                 double limit = limit_liquid;
                 if (two_phase && nu_gas > nu_liquid) {
                     bool gas = !is_liquid(phi[c]);
@@ -89,22 +95,26 @@ CellBox pass_region(const std::vector<double>& r, const Array3<double>& phi,
                     if (gas)
                         limit = limit_gas;
                 }
-                if (!(magnitude > limit))
+                if (!(magnitude > limit)) {
+                    region.settled = std::max(region.settled, share_liquid * magnitude * dx / speed);
                     continue;
+                }
                 const std::array<int, 3> cell = {i, j, k};
                 for (std::size_t a = 0; a < 3; ++a) {
                     box.lo[a] = std::min(box.lo[a], cell[a]);
                     box.hi[a] = std::max(box.hi[a], cell[a] + 1);
                 }
             }
-    if (box.hi[0] == 0)
-        return CellBox{};
+    if (box.hi[0] == 0) {
+        box = CellBox{};
+        return region;
+    }
     const std::array<int, 3> n = {phi.ni(), phi.nj(), phi.nk()};
     for (std::size_t a = 0; a < 3; ++a) {
-        box.lo[a] = std::max(0, box.lo[a] - margin);
-        box.hi[a] = std::min(n[a], box.hi[a] + margin);
+        box.lo[a] = std::max(0, box.lo[a] - std::min(margin, n[a]));
+        box.hi[a] = std::min(n[a], box.hi[a] + std::min(margin, n[a]));
     }
-    return box;
+    return region;
 }
 
 InterfaceInput interface_in_box(const InterfaceInput& interface, const CellBox& box) {

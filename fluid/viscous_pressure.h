@@ -33,7 +33,11 @@
 ///   final projection alone gives the coupled step: the passes matter only at the interface and
 ///   in the gas. With local_passes they run on the box of the cells whose own estimate says so
 ///   (pass_region()), grown by pass_margin cells, their increments vanishing at its cut faces
-///   (box_boundaries()); the final projection then takes the whole grid. On the bench's bubble
+///   (box_boundaries()): δ = 0 on the cut face itself, half a cell out, where the whole grid's
+///   cell outside keeps its pressure at its centre — the increment at the cut faces is that of a
+///   pressure difference 2δ_c instead of δ_c, a mismatch the margin keeps where δ has decayed
+///   (δ vanishes at the cut) and that the next step's projection absorbs; the final projection
+///   then takes the whole grid. On the bench's bubble
 ///   pair at 128³ that box holds 14 % of the cells and the step costs half as much.
 ///
 /// Cells that changed phase since the previous step hold the other phase's pressure (off by
@@ -84,9 +88,10 @@ struct ViscousPressureOptions {
     double pass_tolerance = 1.0e-3;
     /// coupled: run the passes on the box of the cells whose own estimate exceeds
     /// pass_tolerance (pass_region()), grown by pass_margin cells, when that box is at most
-    /// half the grid (one process, no periodic axis, explicit tension); else on the whole grid.
+    /// half the grid (one process, no periodic axis, no inflow or outflow face, explicit
+    /// tension); else on the whole grid.
     bool local_passes = true;
-    /// cells (≥ 0). `validate` B6 quick (viscous drop) is within 0.15 % of the whole grid's ω and
+    /// cells (0 … 1000). `validate` B6 quick (viscous drop) is within 0.15 % of the whole grid's ω and
     /// γ with 8, 0.55 % off with 4; 0 cuts the flow apart (the step blows up).
     int pass_margin = 8;
 
@@ -109,16 +114,24 @@ struct CellBox {
     static CellBox whole(const Array3<double>& cells);
 };
 
+/// Where the coupled scheme's passes are needed (pass_region()).
+struct PassRegion {
+    CellBox box;  ///< empty when no cell needs passes
+    /// The largest own estimate among the cells that do not need them (≤ the tolerance).
+    double settled = 0.0;
+};
+
 /// Where the coupled scheme's passes are needed: the bounding box, grown by `margin` cells and
 /// clipped to the grid, of the unknown cells whose own estimate of how far the projection alone
 /// would leave the coupled velocity, D_c/(1 + D_c) |r_c| Δx / speed, exceeds `tolerance` —
 /// D_c = ν_c Δt/Δx² with ν_c the largest kinematic viscosity μ/ρ of the phases of the cell and
 /// its face neighbours (free_surface: the liquid's), r the negative divergence of the velocity
-/// the viscous solve returned (1/s). Empty when no cell exceeds it. In a liquid of small
-/// diffusion number that is the interface and the gas, not the bulk.
-CellBox pass_region(const std::vector<double>& r, const Array3<double>& phi,
-                    const PhaseOptions& phases, FluidMode mode, double dt, double dx, double speed,
-                    double tolerance, int margin);
+/// the viscous solve returned (1/s). In a liquid of small diffusion number that is the interface
+/// and the gas, not the bulk. Throws std::invalid_argument when the sizes differ, speed or
+/// tolerance is not > 0 or margin is negative.
+PassRegion pass_region(const std::vector<double>& r, const Array3<double>& phi,
+                       const PhaseOptions& phases, FluidMode mode, double dt, double dx,
+                       double speed, double tolerance, int margin);
 
 /// The interface on the cells of `box` (its φ and the κ of its faces), for a grid of the box's
 /// cells. Throws std::invalid_argument when the box is empty or not inside the arrays.
