@@ -314,13 +314,18 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
             diffusion = std::max(diffusion, surface->viscosity * dt / (rho_mean * dx * dx * dx));
         }
         const double viscous_share = diffusion / (1.0 + diffusion);
-        const auto divergence_ratio = [&]() {
-            const double largest = m_blocks.max_abs_cells(r, layer);
-            const double speed =
-                std::max(m_blocks.max(m_grid.max_abs_velocity().maxCoeff()), velocity_floor);
-            return viscous_share * largest * dx / speed;
+        const auto velocity_scale = [&]() {
+            return std::max(m_blocks.max(m_grid.max_abs_velocity().maxCoeff()), velocity_floor);
         };
-        result.pass_change = divergence_ratio();
+        double settled = 0.0;  // with local passes: the largest estimate of the cells left out
+        // The estimate over the cells of r (the whole block's, or the passes' region's).
+        const auto divergence_ratio = [&](const BlockContext& blocks, std::size_t cells_layer,
+                                          double speed) {
+            return std::max(viscous_share * blocks.max_abs_cells(r, cells_layer) * dx / speed,
+                            settled);
+        };
+        const double start_speed = velocity_scale();
+        result.pass_change = divergence_ratio(m_blocks, layer, start_speed);
         result.converged_passes = result.pass_change <= scheme.pass_tolerance;
         // The passes run on the box of the cells that need them (the interface and the gas of a
         // water-air flow), their increments vanishing at its cut faces; the final projection
@@ -329,13 +334,12 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
         // grid, on the whole grid.
         CellBox region = CellBox::whole(m_pressure);
         // (An open face's ambient phase is decided over the whole face: no box reaches one.)
-        double settled = 0.0;  // the largest estimate of the cells left out
         if (!result.converged_passes && scheme.local_passes && !m_blocks.distributed() &&
             !implicit_tension && !m_grid.periodic()[0] && !m_grid.periodic()[1] &&
             !m_grid.periodic()[2] && !whole_boundaries.open() && !whole_boundaries.inflow()) {
-            const double speed = std::max(m_grid.max_abs_velocity().maxCoeff(), velocity_floor);
-            const PassRegion needed = pass_region(r, interface.phi, phases, mode, dt, dx, speed,
-                                                  scheme.pass_tolerance, scheme.pass_margin);
+            const PassRegion needed =
+                pass_region(r, interface.phi, phases, mode, dt, dx, start_speed,
+                            scheme.pass_tolerance, scheme.pass_margin);
             if (needed.box.empty()) {
                 result.converged_passes = true;
                 result.pass_change = needed.settled;
@@ -357,13 +361,11 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
         if (local) {
             region_interface = interface_in_box(interface, region);
             region_boundaries = box_boundaries(whole_increment_boundaries, region, m_box_cells);
-            std::vector<double> whole_r = std::move(r);
-            r.assign(region.size(), 0.0);
-            for (int k = 0; k < region.cells(2); ++k)
-                for (int j = 0; j < region.cells(1); ++j)
-                    for (int i = 0; i < region.cells(0); ++i)
-                        r[region_interface.phi.index(i, j, k)] = whole_r[m_pressure.index(
-                            region.lo[0] + i, region.lo[1] + j, region.lo[2] + k)];
+            Array3<double> whole_r(m_pressure.ni(), m_pressure.nj(), m_pressure.nk());
+            whole_r.storage() = std::move(r);
+            r = std::move(
+                part_at(whole_r, region.lo, region.cells(0), region.cells(1), region.cells(2))
+                    .storage());
         }
         const InterfaceInput& pass_interface = local ? region_interface : interface;
         const BoundaryOptions& pass_boundaries = local ? region_boundaries : increment_boundaries;
@@ -373,12 +375,6 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
             local ? static_cast<std::size_t>(region.cells(0)) * region.cells(1) : layer;
         const Eigen::Vector3d pass_origin =
             m_grid.origin() + dx * Eigen::Vector3d(region.lo[0], region.lo[1], region.lo[2]);
-        const auto pass_ratio = [&]() {
-            const double largest = pass_blocks.max_abs_cells(r, pass_layer);
-            const double speed =
-                std::max(m_blocks.max(m_grid.max_abs_velocity().maxCoeff()), velocity_floor);
-            return std::max(viscous_share * largest * dx / speed, settled);
-        };
         PressureSystem system;
         std::unique_ptr<PressureSystemSolver> poisson;  // its preconditioner serves every pass
         std::vector<double> z, q;
@@ -438,29 +434,13 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
                 break;
             }
             const double alpha = rz / curvature;
-            for (int axis = 0; axis < 3; ++axis) {
-                Array3<double>& u = m_grid.velocity(axis);
-                const Array3<double>& w = impulse.velocity(axis);
-                if (!local) {
-                    for (std::size_t f = 0; f < u.size(); ++f)
-                        u[f] += alpha * w[f];
-                    continue;
-                }
-                for (int k = 0; k < w.nk(); ++k)
-                    for (int j = 0; j < w.nj(); ++j)
-                        for (int i = 0; i < w.ni(); ++i)
-                            u(region.lo[0] + i, region.lo[1] + j, region.lo[2] + k) +=
-                                alpha * w(i, j, k);
-            }
-            for (int k = 0; k < direction.nk(); ++k)
-                for (int j = 0; j < direction.nj(); ++j)
-                    for (int i = 0; i < direction.ni(); ++i)
-                        m_pressure(region.lo[0] + i, region.lo[1] + j, region.lo[2] + k) +=
-                            alpha * direction(i, j, k);
+            for (int axis = 0; axis < 3; ++axis)
+                add_part_at(m_grid.velocity(axis), region.lo, alpha, impulse.velocity(axis));
+            add_part_at(m_pressure, region.lo, alpha, direction);
             for (std::size_t c = 0; c < r.size(); ++c)
                 r[c] -= alpha * q[c];
             ++result.passes;
-            result.pass_change = pass_ratio();
+            result.pass_change = divergence_ratio(pass_blocks, pass_layer, velocity_scale());
             result.converged_passes = result.pass_change <= scheme.pass_tolerance;
             if (!result.converged_passes) {
                 const SolveResult again =

@@ -117,6 +117,46 @@ PassRegion pass_region(const std::vector<double>& r, const Array3<double>& phi,
     return region;
 }
 
+namespace {
+
+/// Does a block of n[0] × n[1] × n[2] values from `lo` fit inside `whole`?
+bool fits(const Array3<double>& whole, const std::array<int, 3>& lo,
+          const std::array<int, 3>& n) {
+    const std::array<int, 3> size = {whole.ni(), whole.nj(), whole.nk()};
+    for (std::size_t a = 0; a < 3; ++a)
+        if (lo[a] < 0 || n[a] < 0 || lo[a] + n[a] > size[a])
+            return false;
+    return true;
+}
+
+}  // namespace
+
+Array3<double> part_at(const Array3<double>& whole, const std::array<int, 3>& lo, int ni, int nj,
+                       int nk) {
+    if (!fits(whole, lo, {ni, nj, nk}))
+        throw std::invalid_argument("part_at: the part is not inside the array");
+    Array3<double> part(ni, nj, nk, 0.0);
+    for (int k = 0; k < nk; ++k)
+        for (int j = 0; j < nj; ++j) {
+            const double* row = whole.data() + whole.index(lo[0], lo[1] + j, lo[2] + k);
+            std::copy(row, row + ni, part.data() + part.index(0, j, k));
+        }
+    return part;
+}
+
+void add_part_at(Array3<double>& whole, const std::array<int, 3>& lo, double alpha,
+                 const Array3<double>& part) {
+    if (!fits(whole, lo, {part.ni(), part.nj(), part.nk()}))
+        throw std::invalid_argument("add_part_at: the part does not fit inside the array");
+    for (int k = 0; k < part.nk(); ++k)
+        for (int j = 0; j < part.nj(); ++j) {
+            double* row = whole.data() + whole.index(lo[0], lo[1] + j, lo[2] + k);
+            const double* from = part.data() + part.index(0, j, k);
+            for (int i = 0; i < part.ni(); ++i)
+                row[i] += alpha * from[i];
+        }
+}
+
 InterfaceInput interface_in_box(const InterfaceInput& interface, const CellBox& box) {
     const Array3<double>& phi = interface.phi;
     for (int a = 0; a < 3; ++a)
@@ -125,21 +165,11 @@ InterfaceInput interface_in_box(const InterfaceInput& interface, const CellBox& 
     if (box.hi[0] > phi.ni() || box.hi[1] > phi.nj() || box.hi[2] > phi.nk())
         throw std::invalid_argument("interface_in_box: the box is not inside the grid");
     InterfaceInput sub;
-    sub.phi.resize(box.cells(0), box.cells(1), box.cells(2), 0.0);
-    for (int k = 0; k < box.cells(2); ++k)
-        for (int j = 0; j < box.cells(1); ++j)
-            for (int i = 0; i < box.cells(0); ++i)
-                sub.phi(i, j, k) = phi(box.lo[0] + i, box.lo[1] + j, box.lo[2] + k);
+    sub.phi = part_at(phi, box.lo, box.cells(0), box.cells(1), box.cells(2));
     for (int axis = 0; axis < 3; ++axis) {
         std::array<int, 3> n = {box.cells(0), box.cells(1), box.cells(2)};
         ++n[static_cast<std::size_t>(axis)];
-        const Array3<double>& kappa = interface.kappa(axis);
-        Array3<double>& out = sub.kappa(axis);
-        out.resize(n[0], n[1], n[2], 0.0);
-        for (int k = 0; k < n[2]; ++k)
-            for (int j = 0; j < n[1]; ++j)
-                for (int i = 0; i < n[0]; ++i)
-                    out(i, j, k) = kappa(box.lo[0] + i, box.lo[1] + j, box.lo[2] + k);
+        sub.kappa(axis) = part_at(interface.kappa(axis), box.lo, n[0], n[1], n[2]);
     }
     return sub;
 }

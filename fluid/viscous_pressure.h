@@ -114,6 +114,16 @@ struct CellBox {
     static CellBox whole(const Array3<double>& cells);
 };
 
+/// The ni × nj × nk values of `whole` from index `lo` on (a box of cells, or of the faces of
+/// one axis). Throws std::invalid_argument when they are not inside `whole`.
+Array3<double> part_at(const Array3<double>& whole, const std::array<int, 3>& lo, int ni, int nj,
+                       int nk);
+
+/// whole(lo + (i, j, k)) += alpha · part(i, j, k) over `part`. Throws std::invalid_argument when
+/// `part` does not fit inside `whole` from `lo`.
+void add_part_at(Array3<double>& whole, const std::array<int, 3>& lo, double alpha,
+                 const Array3<double>& part);
+
 /// Where the coupled scheme's passes are needed (pass_region()).
 struct PassRegion {
     CellBox box;  ///< empty when no cell needs passes

@@ -168,5 +168,21 @@ TEST(LocalPasses, TheRegionsCutFacesAreOutflowsAndItsOwnFacesKeepTheirConditions
     EXPECT_THROW(interface_in_box(interface, CellBox{}), std::invalid_argument);
 }
 
+TEST(LocalPasses, APartIsCopiedOutOfAndAddedBackIntoItsPlace) {
+    Array3<double> whole(5, 4, 3, 0.0);
+    for (std::size_t c = 0; c < whole.size(); ++c)
+        whole[c] = static_cast<double>(c);
+    const Array3<double> part = part_at(whole, {1, 2, 1}, 3, 2, 2);
+    EXPECT_EQ(part(0, 0, 0), whole(1, 2, 1));
+    EXPECT_EQ(part(2, 1, 1), whole(3, 3, 2));
+    Array3<double> sum = whole;
+    add_part_at(sum, {1, 2, 1}, 2.0, part);
+    EXPECT_EQ(sum(3, 3, 2), 3.0 * whole(3, 3, 2));
+    EXPECT_EQ(sum(0, 2, 1), whole(0, 2, 1));  // outside the part: unchanged
+    EXPECT_EQ(sum(4, 3, 2), whole(4, 3, 2));
+    EXPECT_THROW(part_at(whole, {3, 0, 0}, 3, 1, 1), std::invalid_argument);
+    EXPECT_THROW(add_part_at(sum, {0, 3, 0}, 1.0, part), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace meniscus::fluid
