@@ -196,7 +196,8 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
                             "coupled: run the passes on the box of the cells whose own "
                             "estimate exceeds pass_tolerance (the interface and gas of a water-"
                             "air flow), grown by pass_margin cells, when it is at most half the "
-                            "grid (one process, no periodic axis, explicit tension)");
+                            "grid (one process, no periodic axis, no inflow or outflow face, "
+                            "explicit tension)");
                   r.integer("pass_margin", o.viscous_pressure.pass_margin, Range::between(0, 1000),
                             "cells", "coupled: cells added on every side of the passes' box");
               });
