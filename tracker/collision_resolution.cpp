@@ -1,9 +1,10 @@
 #include "tracker/collision_resolution.h"
 
-#include "tracker/broadphase.h"
+#include "tracker/collision_candidates.h"
 #include "tracker/ccd.h"
 #include "tracker/distance.h"
 #include "tracker/impact_zone.h"
+#include "tracker/ordered_collect.h"
 #include "tracker/volume_constraint.h"
 
 #include <tbb/enumerable_thread_specific.h>
@@ -29,27 +30,6 @@ constexpr size_t PARALLEL_GRAIN = 64;
 /// CCD impulses aim for this fraction of ε_p of separating normal displacement, so that a
 /// resolved pair does not end the step exactly touching.
 constexpr double IMPULSE_SEPARATION_FRACTION = 0.1;
-/// Extra padding of the shared broad phase, in units of ε_p: the candidate pairs found once for
-/// the repulsion (static boxes at t0, padded ε_p/2) and the first CCD sweep (swept boxes) stay a
-/// superset for any later displacement within half of this of the one they were built for, so
-/// repulsion impulses and small CCD impulses do not force a new broad phase. (ε_p is ~10⁻³ ξ,
-/// so the extra candidates are a few per cent.)
-constexpr double CANDIDATE_SLACK_FRACTION = 8.0;
-/// The reuse test leaves this fraction of the slack unused, for the rounding of box corners.
-constexpr double CANDIDATE_SLACK_SAFETY = 0.5;
-/// Box corners are rounded sums of coordinates; the slack must dwarf their rounding error
-/// (this many units in the last place of the largest coordinate) or the candidates are rebuilt.
-constexpr double CANDIDATE_ROUNDING_ULPS = 64.0;
-/// When the candidates no longer cover the displacements (impulses and impact zones moved a
-/// vertex by more than the slack allows), the new slack is this many times that move: later
-/// corrections are usually no larger, and each rebuild is a broad phase over the whole mesh
-/// (A4 at 50k triangles rebuilt 4–6 times per step with the fixed slack).
-constexpr double CANDIDATE_SLACK_GROWTH = 4.0;
-/// ... but at most this fraction of the largest displacement coordinate (a shortened step or a
-/// rigid zone moves vertices by a large share of their motion) and of the mean edge length:
-/// boxes padded by more would pair far too many elements.
-constexpr double CANDIDATE_SLACK_CAP = 0.25;
-constexpr double CANDIDATE_SLACK_EDGE_CAP = 0.05;
 
 /// A closed component's volume error below this fraction of its volume is round-off of the
 /// volume sums, not something collision handling changed: the volume correction leaves it.
@@ -57,30 +37,6 @@ constexpr double VOLUME_ERROR_TOLERANCE = 1e-13;
 /// Newton steps of one volume correction attempt at most (each a linearised solve and a volume
 /// sum; the CCD check follows the last).
 constexpr int VOLUME_NEWTON_ITERATIONS = 3;
-
-/// Items per task of ordered_parallel_collect.
-constexpr size_t COLLECT_CHUNK = 4096;
-
-/// What `visit(i, out)` appends for i = 0 … n − 1, in the order of i, computed in parallel
-/// chunks: the result is the serial loop's, whatever the thread count.
-template <typename T, typename Visit>
-std::vector<T> ordered_parallel_collect(size_t n, const Visit& visit) {
-    const size_t chunks = (n + COLLECT_CHUNK - 1) / COLLECT_CHUNK;
-    std::vector<std::vector<T>> parts(chunks);
-    tbb::parallel_for(size_t{0}, chunks, [&](size_t k) {
-        const size_t end = std::min(n, (k + 1) * COLLECT_CHUNK);
-        for (size_t i = k * COLLECT_CHUNK; i < end; ++i)
-            visit(i, parts[k]);
-    });
-    size_t total = 0;
-    for (const std::vector<T>& part : parts)
-        total += part.size();
-    std::vector<T> out;
-    out.reserve(total);
-    for (const std::vector<T>& part : parts)
-        out.insert(out.end(), part.begin(), part.end());
-    return out;
-}
 
 /// Inverse masses (0 for pinned vertices).
 std::vector<double> inverse_masses(const SurfaceMesh& mesh, const std::vector<double>* masses,
@@ -126,21 +82,16 @@ bool apply_impulse(const Contact& c, const std::vector<double>& inv_mass, std::v
     return true;
 }
 
-/// Candidate pairs of a broad phase over the motion x_t0 → x_t0 + d_ref with boxes padded by
-/// `padding`: a superset of the pairs whose boxes overlap for any motion x_t0 → x_t0 + d with
-/// ‖d − d_ref‖∞ small enough (see covers()).
-struct Candidates {
-    std::vector<VertexTrianglePair> vertex_triangle;
-    std::vector<EdgeEdgePair> edge_edge;
-    std::vector<Vec3> d_ref;
-    double padding = 0.0;
-};
-
 class Resolver {
 public:
     Resolver(const SurfaceMesh& mesh, const std::vector<Vec3>& x_t0, const CollisionOptions& o,
              std::vector<double> inv_mass, CollisionReport* report = nullptr)
-        : m_mesh(mesh), m_x0(x_t0), m_o(o), m_inv_mass(std::move(inv_mass)), m_report(report) {}
+        : m_mesh(mesh),
+          m_x0(x_t0),
+          m_o(o),
+          m_inv_mass(std::move(inv_mass)),
+          m_candidates(mesh, x_t0, o.proximity_epsilon),
+          m_report(report) {}
 
     /// Phase 1: proximity repulsion at t0 (paper: push apart to ε_p over the step). Builds the
     /// broad phase that the first CCD sweep reuses: swept boxes of the requested motion padded
@@ -148,42 +99,27 @@ public:
     /// by the exact static box test, so the contacts are the ones a static broad phase gives.
     int repel(std::vector<Vec3>& d) {
         const double padding = 0.5 * m_o.proximity_epsilon;
-        m_candidates = build_candidates(d, padding + CANDIDATE_SLACK_FRACTION * m_o.proximity_epsilon);
+        m_candidates.build(d, padding);
+        count_broad_phase();
         m_detected_d.clear();
-        const size_t vt_count = m_candidates.vertex_triangle.size();
-        const std::vector<Contact> contacts = ordered_parallel_collect<Contact>(
-            vt_count + m_candidates.edge_edge.size(), [&](size_t i, std::vector<Contact>& out) {
-                if (m_mesh.periodic()) {
-                    repel_periodic(i, vt_count, padding, out);
+        const size_t count =
+            m_candidates.vertex_triangle().size() + m_candidates.edge_edge().size();
+        const std::vector<Contact> contacts =
+            ordered_parallel_collect<Contact>(count, [&](size_t i, std::vector<Contact>& out) {
+                size_t split = 1;
+                const std::array<int, 4> v = m_candidates.vertices(i, &split);
+                std::array<Vec3, 4> q;
+                if (!m_candidates.static_boxes_overlap(v, split, padding, q))
                     return;
-                }
-                if (i < vt_count) {
-                    const VertexTrianglePair& p = m_candidates.vertex_triangle[i];
-                    const Triangle& t = m_mesh.triangle(p.ti);
-                    if (!boxes_overlap(static_box({p.vi}, padding),
-                                       static_box({t[0], t[1], t[2]}, padding)))
-                        return;
-                    const auto prox =
-                        point_triangle_proximity(x0(p.vi), x0(t[0]), x0(t[1]), x0(t[2]));
+                const auto add = [&](const auto& prox) {
                     if (prox.distance < m_o.proximity_epsilon)
-                        out.push_back({{p.vi, t[0], t[1], t[2]},
-                                       prox.weights,
-                                       prox.normal,
-                                       m_o.proximity_epsilon - prox.distance});
-                } else {
-                    const EdgeEdgePair& p = m_candidates.edge_edge[i - vt_count];
-                    const Edge& a = m_mesh.edge(p.ei);
-                    const Edge& b = m_mesh.edge(p.ej);
-                    if (!boxes_overlap(static_box({a[0], a[1]}, padding),
-                                       static_box({b[0], b[1]}, padding)))
-                        return;
-                    const auto prox = edge_edge_proximity(x0(a[0]), x0(a[1]), x0(b[0]), x0(b[1]));
-                    if (prox.distance < m_o.proximity_epsilon)
-                        out.push_back({{a[0], a[1], b[0], b[1]},
-                                       prox.weights,
-                                       prox.normal,
-                                       m_o.proximity_epsilon - prox.distance});
-                }
+                        out.push_back(
+                            {v, prox.weights, prox.normal, m_o.proximity_epsilon - prox.distance});
+                };
+                if (split == 1)
+                    add(point_triangle_proximity(q[0], q[1], q[2], q[3]));
+                else
+                    add(edge_edge_proximity(q[0], q[1], q[2], q[3]));
             });
         for (const Contact& c : contacts)
             apply_impulse(c, m_inv_mass, d);
@@ -198,16 +134,8 @@ public:
         std::vector<Vec3> x1(m_x0.size());
         for (size_t i = 0; i < x1.size(); ++i)
             x1[i] = m_x0[i] + d[i];
-        double moved = 0.0;  // how far the displacements left the last candidates' reference
-        if (!covers(m_candidates, d, &moved)) {
-            double largest = 0.0;  // largest displacement coordinate: bounds the useful slack
-            for (const Vec3& di : d)
-                largest = std::max(largest, di.cwiseAbs().maxCoeff());
-            const double slack = CANDIDATE_SLACK_FRACTION * m_o.proximity_epsilon;
-            const double grown =
-                std::min({CANDIDATE_SLACK_GROWTH * moved, CANDIDATE_SLACK_CAP * largest,
-                          CANDIDATE_SLACK_EDGE_CAP * mean_edge_length()});
-            m_candidates = build_candidates(d, std::isfinite(grown) ? std::max(slack, grown) : slack);
+        if (m_candidates.cover(d)) {
+            count_broad_phase();
             m_detected_d.clear();
         }
         // Only pairs with a vertex whose displacement changed since the last call are tested;
@@ -218,8 +146,8 @@ public:
             for (size_t i = 0; i < d.size(); ++i)
                 changed[i] = d[i] != m_detected_d[i] ? 1 : 0;
         }
-        const std::vector<VertexTrianglePair> vt = filter_vertex_triangle(x1, changed);
-        const std::vector<EdgeEdgePair> ee = filter_edge_edge(x1, changed);
+        const std::vector<VertexTrianglePair> vt = m_candidates.moving_vertex_triangle(x1, changed);
+        const std::vector<EdgeEdgePair> ee = m_candidates.moving_edge_edge(x1, changed);
         tbb::enumerable_thread_specific<std::vector<Contact>> local;
         const double target = IMPULSE_SEPARATION_FRACTION * m_o.proximity_epsilon;
         tbb::parallel_for(tbb::blocked_range<size_t>(0, vt.size() + ee.size(), PARALLEL_GRAIN),
@@ -392,226 +320,22 @@ private:
         return x;
     }
 
-    /// Mean length of the live edges at t0 (computed once).
-    double mean_edge_length() {
-        if (m_mean_edge_length < 0.0) {
-            double sum = 0.0;
-            int count = 0;
-            for (int ei = 0; ei < m_mesh.num_edges(); ++ei)
-                if (m_mesh.edge_alive(ei)) {
-                    const Edge& e = m_mesh.edge(ei);
-                    sum += m_mesh.periodic()
-                               ? m_mesh.periods().difference(x0(e[1]), x0(e[0])).norm()
-                               : (x0(e[1]) - x0(e[0])).norm();
-                    ++count;
-                }
-            m_mean_edge_length = count > 0 ? sum / count : 0.0;
-        }
-        return m_mean_edge_length;
-    }
-
-    Candidates build_candidates(const std::vector<Vec3>& d, double padding) const {
+    void count_broad_phase() const {
         if (m_report)
             ++m_report->broad_phases;
-        std::vector<Vec3> x1(m_x0.size());
-        for (size_t i = 0; i < x1.size(); ++i)
-            x1[i] = m_x0[i] + d[i];
-        const BroadPhase broad(m_mesh, m_x0, x1, padding);
-        return {broad.vertex_triangle_pairs(), broad.edge_edge_pairs(), d, padding};
-    }
-
-    /// True when every box of the motion x0 → x0 + d (unpadded) lies inside the corresponding
-    /// box the candidates were built from: each end position moved by at most half the padding
-    /// (the other half absorbs the rounding of the corners, which must be negligible).
-    /// `moved_out` (optional) receives max |d − d_ref|∞ (0 when the sizes differ).
-    bool covers(const Candidates& c, const std::vector<Vec3>& d, double* moved_out = nullptr) const {
-        if (moved_out)
-            *moved_out = 0.0;
-        if (c.d_ref.size() != d.size() || !(c.padding > 0.0))
-            return false;
-        double moved = 0.0, coordinate = 0.0;
-        for (size_t i = 0; i < d.size(); ++i) {
-            moved = std::max(moved, (d[i] - c.d_ref[i]).cwiseAbs().maxCoeff());
-            coordinate = std::max({coordinate, m_x0[i].cwiseAbs().maxCoeff(),
-                                   (m_x0[i] + d[i]).cwiseAbs().maxCoeff(),
-                                   (m_x0[i] + c.d_ref[i]).cwiseAbs().maxCoeff()});
-        }
-        if (moved_out)
-            *moved_out = moved;
-        const double rounding =
-            CANDIDATE_ROUNDING_ULPS * std::numeric_limits<double>::epsilon() * coordinate;
-        return std::isfinite(moved) && std::isfinite(coordinate) &&
-               CANDIDATE_SLACK_SAFETY * c.padding > rounding &&
-               moved <= CANDIDATE_SLACK_SAFETY * c.padding - rounding;
-    }
-
-    Box3d static_box(std::initializer_list<int> vertices, double padding) const {
-        Box3d b;
-        for (int vi : vertices)
-            b.extend(x0(vi));
-        b.min().array() -= padding;
-        b.max().array() += padding;
-        return b;
-    }
-
-    Box3d moving_box(std::initializer_list<int> vertices, const std::vector<Vec3>& x1) const {
-        Box3d b;
-        for (int vi : vertices) {
-            b.extend(x0(vi));
-            b.extend(x1[static_cast<size_t>(vi)]);
-        }
-        return b;
-    }
-
-    // ---- periodic meshes (issue 39): every pair read by the minimum image ----------------
-    // The pair's vertices v (v[0] the first vertex of its first element) at their images
-    // nearest x0(v[0]): vertex k at x0(v[k]) + s_k and x1[v[k]] + s_k, the same shift at both
-    // times, s_k = shift_towards(x0(v[k]), x0(v[0])).
-
-    void unwrap(const std::array<int, 4>& v, const std::vector<Vec3>& x1, std::array<Vec3, 4>& p0,
-                std::array<Vec3, 4>& p1) const {
-        const MeshPeriods& periods = m_mesh.periods();
-        const Vec3& ref = x0(v[0]);
-        for (size_t k = 0; k < 4; ++k) {
-            const auto i = static_cast<size_t>(v[k]);
-            const Vec3 s = k == 0 ? Vec3::Zero() : periods.shift_towards(m_x0[i], ref);
-            p0[k] = m_x0[i] + s;
-            p1[k] = x1[i] + s;
-        }
-    }
-
-    void unwrap_t0(const std::array<int, 4>& v, std::array<Vec3, 4>& p0) const {
-        const MeshPeriods& periods = m_mesh.periods();
-        const Vec3& ref = x0(v[0]);
-        p0[0] = ref;
-        for (size_t k = 1; k < 4; ++k)
-            p0[k] = periods.nearest_image(x0(v[k]), ref);
-    }
-
-    /// Do the swept boxes of the pair's first `split` vertices and of the others overlap,
-    /// read by the minimum image?
-    bool swept_boxes_overlap(const std::array<int, 4>& v, size_t split,
-                             const std::vector<Vec3>& x1) const {
-        std::array<Vec3, 4> p0, p1;
-        unwrap(v, x1, p0, p1);
-        Box3d a, b;
-        for (size_t k = 0; k < 4; ++k) {
-            Box3d& box = k < split ? a : b;
-            box.extend(p0[k]);
-            box.extend(p1[k]);
-        }
-        return boxes_overlap(a, b);
-    }
-
-    /// repel()'s test of candidate i on a periodic mesh.
-    void repel_periodic(size_t i, size_t vt_count, double padding,
-                        std::vector<Contact>& out) const {
-        std::array<int, 4> v;
-        size_t split = 1;
-        if (i < vt_count) {
-            const VertexTrianglePair& p = m_candidates.vertex_triangle[i];
-            const Triangle& t = m_mesh.triangle(p.ti);
-            v = {p.vi, t[0], t[1], t[2]};
-        } else {
-            const EdgeEdgePair& p = m_candidates.edge_edge[i - vt_count];
-            const Edge& a = m_mesh.edge(p.ei);
-            const Edge& b = m_mesh.edge(p.ej);
-            v = {a[0], a[1], b[0], b[1]};
-            split = 2;
-        }
-        std::array<Vec3, 4> q;
-        unwrap_t0(v, q);
-        Box3d a, b;
-        for (size_t k = 0; k < 4; ++k)
-            (k < split ? a : b).extend(q[k]);
-        a.min().array() -= padding;
-        a.max().array() += padding;
-        b.min().array() -= padding;
-        b.max().array() += padding;
-        if (!boxes_overlap(a, b))
-            return;
-        if (split == 1) {
-            const auto prox = point_triangle_proximity(q[0], q[1], q[2], q[3]);
-            if (prox.distance < m_o.proximity_epsilon)
-                out.push_back(
-                    {v, prox.weights, prox.normal, m_o.proximity_epsilon - prox.distance});
-        } else {
-            const auto prox = edge_edge_proximity(q[0], q[1], q[2], q[3]);
-            if (prox.distance < m_o.proximity_epsilon)
-                out.push_back(
-                    {v, prox.weights, prox.normal, m_o.proximity_epsilon - prox.distance});
-        }
-    }
-
-    static bool boxes_overlap(const Box3d& a, const Box3d& b) {
-        return (a.min().array() <= b.max().array()).all() &&
-               (b.min().array() <= a.max().array()).all();
-    }
-
-    static bool any_changed(const std::vector<std::uint8_t>& changed,
-                            const std::array<int, 4>& v) {
-        return changed.empty() || changed[static_cast<size_t>(v[0])] ||
-               changed[static_cast<size_t>(v[1])] || changed[static_cast<size_t>(v[2])] ||
-               changed[static_cast<size_t>(v[3])];
-    }
-
-    /// The candidates with a changed vertex (all when `changed` is empty) whose unpadded swept
-    /// boxes overlap: with every vertex changed, exactly what BroadPhase(x0, x1, 0) returns, in
-    /// the same (sorted) order.
-    std::vector<VertexTrianglePair> filter_vertex_triangle(
-        const std::vector<Vec3>& x1, const std::vector<std::uint8_t>& changed) const {
-        const std::vector<VertexTrianglePair>& all = m_candidates.vertex_triangle;
-        return ordered_parallel_collect<VertexTrianglePair>(
-            all.size(), [&](size_t i, std::vector<VertexTrianglePair>& out) {
-                const VertexTrianglePair& p = all[i];
-                const Triangle& t = m_mesh.triangle(p.ti);
-                if (!any_changed(changed, {p.vi, t[0], t[1], t[2]}))
-                    return;
-                if (m_mesh.periodic() ? swept_boxes_overlap({p.vi, t[0], t[1], t[2]}, 1, x1)
-                                      : boxes_overlap(moving_box({p.vi}, x1),
-                                                      moving_box({t[0], t[1], t[2]}, x1)))
-                    out.push_back(p);
-            });
-    }
-    std::vector<EdgeEdgePair> filter_edge_edge(const std::vector<Vec3>& x1,
-                                               const std::vector<std::uint8_t>& changed) const {
-        const std::vector<EdgeEdgePair>& all = m_candidates.edge_edge;
-        return ordered_parallel_collect<EdgeEdgePair>(
-            all.size(), [&](size_t i, std::vector<EdgeEdgePair>& out) {
-                const EdgeEdgePair& p = all[i];
-                const Edge& a = m_mesh.edge(p.ei);
-                const Edge& b = m_mesh.edge(p.ej);
-                if (!any_changed(changed, {a[0], a[1], b[0], b[1]}))
-                    return;
-                if (m_mesh.periodic() ? swept_boxes_overlap({a[0], a[1], b[0], b[1]}, 2, x1)
-                                      : boxes_overlap(moving_box({a[0], a[1]}, x1),
-                                                      moving_box({b[0], b[1]}, x1)))
-                    out.push_back(p);
-            });
     }
 
     void test(const std::array<int, 4>& v, const std::vector<Vec3>& x1, bool edge_edge,
               double target, std::vector<Contact>& out) const {
-        if (m_mesh.periodic()) {
-            std::array<Vec3, 4> q0, q1;
-            unwrap(v, x1, q0, q1);
-            const CcdResult r =
-                edge_edge ? edge_edge_ccd_detailed(q0[0], q0[1], q0[2], q0[3], q1[0], q1[1], q1[2],
-                                                   q1[3])
-                          : point_triangle_ccd_detailed(q0[0], q0[1], q0[2], q0[3], q1[0], q1[1],
-                                                        q1[2], q1[3]);
-            if (r.may_collide)
-                out.push_back({v, r.weights, r.normal, target, edge_edge});
-            return;
-        }
-        const auto p0 = [&](int k) -> const Vec3& { return m_x0[static_cast<size_t>(v[k])]; };
-        const auto p1 = [&](int k) -> const Vec3& { return x1[static_cast<size_t>(v[k])]; };
+        std::array<Vec3, 4> q0, q1;
+        pair_positions(m_mesh, m_x0, x1, v, q0, q1);
         // One detailed query: its may_collide is the boolean query's answer (ccd.h), and a hit
         // is not searched twice (true contacts are the expensive CCD queries).
-        const CcdResult r = edge_edge ? edge_edge_ccd_detailed(p0(0), p0(1), p0(2), p0(3), p1(0),
-                                                               p1(1), p1(2), p1(3))
-                                      : point_triangle_ccd_detailed(p0(0), p0(1), p0(2), p0(3),
-                                                                    p1(0), p1(1), p1(2), p1(3));
+        const CcdResult r =
+            edge_edge
+                ? edge_edge_ccd_detailed(q0[0], q0[1], q0[2], q0[3], q1[0], q1[1], q1[2], q1[3])
+                : point_triangle_ccd_detailed(q0[0], q0[1], q0[2], q0[3], q1[0], q1[1], q1[2],
+                                              q1[3]);
         if (r.may_collide)
             out.push_back({v, r.weights, r.normal, target, edge_edge});
     }
@@ -716,10 +440,9 @@ private:
     const std::vector<Vec3>& m_x0;
     const CollisionOptions& m_o;
     std::vector<double> m_inv_mass;
-    Candidates m_candidates;
-    /// detect()'s last displacements and contacts, on the current candidates (empty: none).
+    CollisionCandidates m_candidates;
     CollisionReport* m_report = nullptr;  ///< counts broad phases when set
-    double m_mean_edge_length = -1.0;     ///< < 0: not computed yet
+    /// detect()'s last displacements and contacts, on the current candidates (empty: none).
     std::vector<Vec3> m_detected_d;
     std::vector<Contact> m_detected;
 };
