@@ -35,6 +35,10 @@ constexpr double MAX_PASS_REGION_SHARE = 0.5;
 /// (or at the viscosity's own tolerance when that is looser).
 constexpr double INNER_TOLERANCE_SHARE = 0.1;
 
+/// Coupled scheme: the final projection's relative tolerance, scaled to the divergence before
+/// the passes, is kept at most this (the scale can be large when the passes converged far).
+constexpr double MAX_FINAL_PROJECTION_TOLERANCE = 0.5;
+
 /// Subtracts the mean over the pressure system's unknown cells (all cells in two_phase, liquid
 /// cells in free_surface) from `pressure` on those cells (every cell of the block: the mean is a
 /// constant).
@@ -158,9 +162,11 @@ FluidSolver::FluidSolver(int nx, int ny, int nz, double dx, const Eigen::Vector3
 ProjectionResult FluidSolver::projection(MacGrid& grid, const InterfaceInput& interface,
                                          const PhaseOptions& phases, double dt,
                                          Array3<double>& pressure,
-                                         const BoundaryOptions& boundaries) const {
-    return project_block(grid, interface, phases, m_options.mode, dt, m_options.pressure, pressure,
-                         boundaries, m_blocks.decomposition(), m_blocks.ranks());
+                                         const BoundaryOptions& boundaries,
+                                         const PressureOptions* options) const {
+    return project_block(grid, interface, phases, m_options.mode, dt,
+                         options ? *options : m_options.pressure, pressure, boundaries,
+                         m_blocks.decomposition(), m_blocks.ranks());
 }
 
 StepResult FluidSolver::step(double dt, const InterfaceInput& interface) {
@@ -286,6 +292,8 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
                                 m_options.viscosity, m_options.pressure.min_liquid_fraction));
     clock.lap_into(result.timings.viscosity);
 
+    // ‖D u‖ before the passes (zero when none run).
+    double divergence_before = 0.0;
     if (max_iterations > 0) {
         // Uzawa–PCG on T δ = −D u, T = Gᵀ A⁻¹ G: u ← u + V(δ) with V(δ) = −A⁻¹ G δ the viscous
         // solve of the velocity impulse −Δt/ρ G δ, so the residual is always −D u.
@@ -293,6 +301,7 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
         std::vector<double> r = unknown_divergence(m_grid, interface, mode);
         for (double& x : r)
             x = -x;
+        divergence_before = std::sqrt(m_blocks.dot_cells(r, r, layer));
         // The velocity scale: the flow's, the body force's over the step, or (at rest without
         // gravity) a displacement of RESTING_CELLS_PER_STEP cells per step.
         const double velocity_floor =
@@ -460,9 +469,23 @@ void FluidSolver::incremental_step(double dt, const InterfaceInput& interface, S
     }
 
     // The projection of what is left: u divergence-free to the pressure solver's tolerance.
+    // After passes its tolerance is relative to the divergence before them: the step's velocity
+    // then is as divergence-free as the incremental scheme's (whose projection solves that
+    // divergence to the tolerance), not the passes' residual solved a second time over.
     clock = PhaseClock();
-    const ProjectionResult projected = projection(m_grid, interface, increment_phases, dt,
-                                                  m_increment, whole_increment_boundaries);
+    PressureOptions final_options = m_options.pressure;
+    if (result.passes > 0 && divergence_before > 0.0) {
+        const std::vector<double> left = unknown_divergence(m_grid, interface, mode);
+        const double divergence_after = std::sqrt(m_blocks.dot_cells(left, left, layer));
+        if (divergence_after > 0.0 && divergence_after < divergence_before)
+            final_options.iteration.tolerance =
+                std::min(MAX_FINAL_PROJECTION_TOLERANCE,
+                         final_options.iteration.tolerance * divergence_before / divergence_after);
+    }
+    clock.lap_into(result.timings.pressure_solve);
+    const ProjectionResult projected =
+        projection(m_grid, interface, increment_phases, dt, m_increment, whole_increment_boundaries,
+                   &final_options);
     for (std::size_t c = 0; c < m_pressure.size(); ++c)
         m_pressure[c] += m_increment[c];
     if (projected.singular)

@@ -174,10 +174,12 @@ private:
     /// The incremental and coupled schemes.
     void incremental_step(double dt, const InterfaceInput& interface, StepResult& result);
 
-    /// project_block() (project() on one process) with the whole box's `boundaries`.
+    /// project_block() (project() on one process) with the whole box's `boundaries` and
+    /// `options` (default: m_options.pressure).
     ProjectionResult projection(MacGrid& grid, const InterfaceInput& interface,
                                 const PhaseOptions& phases, double dt, Array3<double>& pressure,
-                                const BoundaryOptions& boundaries) const;
+                                const BoundaryOptions& boundaries,
+                                const PressureOptions* options = nullptr) const;
 
     FluidOptions m_options;
     BlockContext m_blocks;
