@@ -147,6 +147,9 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
              "relative residual of the pressure solve");
     v.integer("pressure_max_iterations", o.pressure.iteration.max_iterations,
               Range::between(1, 100000), "", "PCG iterations before a pressure solve gives up");
+    v.boolean("pressure_single_precision", o.pressure.multigrid.single_precision,
+              "multigrid_pcg: run the V-cycles in float (the CG around them stays in double; "
+              "same iterations and accuracy, half the smoother's memory traffic)");
     v.number("viscosity_tolerance", o.viscosity.iteration.tolerance, Range{0.0, 1.0, true, true},
              "", "relative residual of the implicit viscosity solve");
     enum_field(v, "viscosity_weights", o.viscosity.weights,
@@ -168,6 +171,9 @@ void visit_fields(V& v, fluid::FluidOptions& o) {
                "at 10x the capillary limit, but a sparse LU each step)");
     v.integer("viscosity_max_iterations", o.viscosity.iteration.max_iterations,
               Range::between(1, 100000), "", "CG iterations before a viscosity solve gives up");
+    v.boolean("viscosity_single_precision", o.viscosity.multigrid.single_precision,
+              "viscosity_preconditioner multigrid: run the V-cycles in float (the CG around them "
+              "stays in double)");
     v.section("viscous_pressure", "how the viscous and pressure solves are coupled in a step",
               [&](auto& r) {
                   enum_field(r, "coupling", o.viscous_pressure.coupling,

@@ -9,9 +9,18 @@
 /// scaled by ½ the same way; transfers are cell-centred
 /// trilinear prolongation P and restriction Pᵀ (wrapping around periodic axes, see
 /// PoissonMatrix::periodic); smoothing is red–black Gauss–Seidel, red→black
-/// before and black→red after the coarse correction so the cycle is a symmetric operator.
+/// before and black→red after the coarse correction so the cycle is a symmetric operator (the
+/// smoother multiplies by the inverse diagonal, kept per level).
+///
+/// By default the cycle runs in single precision (the matrices and vectors of every level in
+/// float: half the memory traffic of its sweeps and transfers) while the Krylov solve around it
+/// stays in double: the cycle's rounding, about 1e-7 of the correction, lies far
+/// below its own approximation error, so the outer iterations and the solution's accuracy are
+/// those of the double cycle (the residual is computed in double). The residual passed in is
+/// scaled by a power of two into float's range and the result scaled back (both exact).
 
 #include <array>
+#include <memory>
 #include <vector>
 
 #include "fluid/pcg.h"
@@ -27,18 +36,13 @@ struct MultigridOptions {
     /// Without periodic axes, run a red and a black half sweep in one pass over memory (plane
     /// k's first colour, then plane k−1's second): the same result, bit for bit.
     bool pipelined_sweeps = true;
+    /// Run the cycles in float (see file comment); false: in double. A matrix whose diagonal
+    /// spans more than float's range (2^100 between its largest and smallest positive entry) is
+    /// cycled in double either way.
+    bool single_precision = true;
 
     /// Throws std::invalid_argument naming the field when out of range.
     void validate() const;
-};
-
-/// x on the first and the last plane of each periodic axis of a level, taken before each half
-/// sweep of the smoother: neighbours across the seam are read from here, so where an odd cell
-/// count puts one colour on both sides of the seam the half sweep is still a Jacobi update of its
-/// colour (the cycle stays symmetric, and independent of the order and the threads).
-struct SeamPlanes {
-    std::array<std::vector<double>, 3> first;
-    std::array<std::vector<double>, 3> last;
 };
 
 /// One V-cycle from a zero initial guess, as a symmetric preconditioner. The hierarchy is built in
@@ -49,9 +53,14 @@ public:
     /// Builds the coarse levels of `matrix` (which must outlive this object).
     /// Throws std::invalid_argument when `options` are invalid.
     MultigridPreconditioner(const PoissonMatrix& matrix, const MultigridOptions& options = {});
+    ~MultigridPreconditioner() override;
+    MultigridPreconditioner(const MultigridPreconditioner&) = delete;
+    MultigridPreconditioner& operator=(const MultigridPreconditioner&) = delete;
     void apply(const std::vector<double>& r, std::vector<double>& z) const override;
     /// Number of levels including the finest.
-    int levels() const { return static_cast<int>(m_levels.size()); }
+    int levels() const;
+    /// True when the cycles run in float (options.single_precision and a matrix that fits).
+    bool single_precision() const;
 
     /// 1D transfer weights between a fine axis of n cells and its coarse axis of (n+1)/2 cells.
     struct AxisTransfer {
@@ -63,26 +72,11 @@ public:
         std::vector<int> restrict_cell;  ///< 4 per coarse cell
         std::vector<double> restrict_weight;
     };
+    /// The hierarchy and its V-cycle in one precision (multigrid.cpp).
+    class Cycle;
 
 private:
-    struct Level {
-        PoissonMatrix matrix;           ///< unused for level 0 (the caller's matrix)
-        mutable std::vector<double> x;  ///< correction on this level (coarse levels only)
-        mutable std::vector<double> b;  ///< right-hand side on this level (coarse levels only)
-        mutable std::vector<double> r;  ///< residual scratch
-        /// the transfers' scratch: after their x pass and after their x and y passes
-        mutable std::vector<double> along_x, along_xy;
-        AxisTransfer transfer[3];       ///< to the next coarser level
-        /// x on the seam planes of periodic axes during a half sweep (smoother scratch)
-        mutable SeamPlanes seams;
-    };
-    const PoissonMatrix& level_matrix(std::size_t level) const;
-    /// One V-cycle from x = 0 on `level` for right-hand side b (x is overwritten).
-    void cycle(std::size_t level, const std::vector<double>& b, std::vector<double>& x) const;
-
-    const PoissonMatrix& m_fine;
-    MultigridOptions m_options;
-    std::vector<Level> m_levels;
+    std::unique_ptr<const Cycle> m_cycle;
 };
 
 }  // namespace meniscus::fluid

@@ -14,16 +14,18 @@
 
 namespace meniscus::fluid {
 
-/// Symmetric 7-point matrix with one diagonal and three off-diagonal arrays (8 bytes each per
+/// Symmetric 7-point matrix with one diagonal and three off-diagonal arrays (one T each per
 /// cell). off_x(i, j, k) = A(cell(i,j,k), cell(i+1,j,k)) ≤ 0, likewise off_y and off_z. Along a
 /// `periodic` axis the last cell's entry couples it to the first (off_x(ni−1, j, k) =
 /// A(cell(ni−1,j,k), cell(0,j,k)): the face across the periodic seam); along the other axes
-/// entries pointing outside the grid are 0.
-struct PoissonMatrix {
-    Array3<double> diag;
-    Array3<double> off_x;
-    Array3<double> off_y;
-    Array3<double> off_z;
+/// entries pointing outside the grid are 0. T is double (PoissonMatrix, the systems the solvers
+/// solve) or float (the single-precision V-cycles of multigrid.h).
+template <class T>
+struct BasicPoissonMatrix {
+    Array3<T> diag;
+    Array3<T> off_x;
+    Array3<T> off_y;
+    Array3<T> off_z;
     /// Per axis: does the last cell's off-diagonal entry wrap around to the first cell?
     std::array<bool, 3> periodic = {false, false, false};
 
@@ -38,22 +40,27 @@ struct PoissonMatrix {
     std::size_t active_count() const;
 
     /// y = A x (TBB-parallel over z-slabs). x and y have size(); y is resized if needed.
-    void apply(const std::vector<double>& x, std::vector<double>& y) const;
+    void apply(const std::vector<T>& x, std::vector<T>& y) const;
+    /// y = A x as apply(), returning x·y from the same pass (summed in a fixed order).
+    double apply_dot(const std::vector<T>& x, std::vector<T>& y) const;
     /// The off-diagonal array of `axis` (0 → off_x, 1 → off_y, 2 → off_z).
-    Array3<double>& off(int axis) { return axis == 0 ? off_x : (axis == 1 ? off_y : off_z); }
-    const Array3<double>& off(int axis) const {
-        return axis == 0 ? off_x : (axis == 1 ? off_y : off_z);
-    }
+    Array3<T>& off(int axis) { return axis == 0 ? off_x : (axis == 1 ? off_y : off_z); }
+    const Array3<T>& off(int axis) const { return axis == 0 ? off_x : (axis == 1 ? off_y : off_z); }
     /// True if some axis is periodic.
     bool any_periodic() const { return periodic[0] || periodic[1] || periodic[2]; }
     /// A copy without the couplings across periodic seams (those entries zeroed, no axis
     /// periodic): the same diagonal, so it stays positive definite where A is semidefinite.
-    PoissonMatrix without_wrap() const;
+    BasicPoissonMatrix without_wrap() const;
 
     /// r = b − A x.
-    void residual(const std::vector<double>& x, const std::vector<double>& b,
-                  std::vector<double>& r) const;
+    void residual(const std::vector<T>& x, const std::vector<T>& b, std::vector<T>& r) const;
 };
+
+// Defined in poisson_matrix.cpp for these two.
+extern template struct BasicPoissonMatrix<double>;
+extern template struct BasicPoissonMatrix<float>;
+
+using PoissonMatrix = BasicPoissonMatrix<double>;
 
 /// Σ a_i b_i, TBB-parallel with a deterministic reduction order.
 double dot(const std::vector<double>& a, const std::vector<double>& b);
