@@ -100,12 +100,13 @@ constexpr double ADVECTION_DOUBLES = 66.0;
 // residual 63, the result 15: about 180.
 constexpr double VISCOSITY_ITERATION_DOUBLES = 84.0;
 constexpr double VISCOSITY_STEP_DOUBLES = 180.0;
-// Pressure per PCG iteration: the PCG core 30 (A·p 6, p·q 2, two axpy 6, mean removal of r and
-// z 10, r·r 1, r·z 2, p = z + βp 3) and one V-cycle 54.5 (bench_pressure.cpp's count).
-// Per step besides: the hierarchy 6, the first residual and V-cycle 70, the gradient 12, the
-// divergence check 4, adding the increment and its mean 7: about 100.
-constexpr double PRESSURE_ITERATION_DOUBLES = 84.5;
-constexpr double PRESSURE_STEP_DOUBLES = 100.0;
+// Pressure per PCG iteration: the PCG core 18 (four fused passes: A·p with p·q 6, the x and r
+// updates with r·r 6, r·z 2, the new direction 4) and one V-cycle in float 30.7
+// (bench_pressure.cpp's counts). Per step besides: the hierarchy 6, its float copy and inverse
+// diagonals 8, the first residual and V-cycle 46, the gradient 12, the divergence check 4,
+// adding the increment and its mean 7: about 83.
+constexpr double PRESSURE_ITERATION_DOUBLES = 48.7;
+constexpr double PRESSURE_STEP_DOUBLES = 83.0;
 constexpr double BYTES_PER_DOUBLE = sizeof(double);
 
 /// STREAM-style copy bandwidth, bytes/s, with `threads` TBB threads: b ← a over two 256 MiB

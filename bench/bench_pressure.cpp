@@ -40,17 +40,19 @@ constexpr std::size_t BYTES_PER_DOUBLE = sizeof(double);
 constexpr double GIGA = 1e9;
 
 // Memory traffic model per PCG iteration, in doubles per cell, from the kernels in fluid/:
-// PCG core (pure-Neumann system): A·p 6 (diag, 3 off-diagonals, p, q), p·q 2, two axpy 3 + 3,
-// mean removal of r and z 5 + 5, r·r 1, r·z 2, p = z + βp 3.
-constexpr double PCG_CORE_DOUBLES = 30.0;
+// PCG core (pure-Neumann system, pcg.cpp's four fused passes): A·p with p·q 6 (diag, 3
+// off-diagonals, p, q), x and r updated with r·r and Σr 6, r·z with Σz 2, p = (z − mean) + βp 4
+// (z, p, diag, p out).
+constexpr double PCG_CORE_DOUBLES = 18.0;
 // MIC(0): clear z 1, forward sweep 6 (r, pivot, 3 off-diagonals, q), backward sweep 6.
 constexpr double MIC0_DOUBLES = 13.0;
-// Multigrid V-cycle on the finest level (works in place on r and z): four pipelined red-black
-// pairs (multigrid.h), each streaming diag, 3 off-diagonals, b and x in and x out (7), plus an
-// eighth of that again for the slab-edge planes of their second pass: 31.5; the residual 9; the
+// Multigrid V-cycle on the finest level, counted in doubles: four pipelined red-black pairs
+// (multigrid.h), each streaming diag, 3 off-diagonals, b and x in and x out (7), plus an eighth
+// of that again for the slab-edge planes of their second pass: 31.5; the residual 9; the
 // restriction one axis at a time 2.6 and the prolongation 4.6 (their scratch arrays included) =
-// 47.7; coarser levels add 1/8 + 1/64 + ... ≈ 1/7.
-constexpr double MULTIGRID_DOUBLES = 47.7 * 8.0 / 7.0;
+// 47.7. The cycle runs in float (the default): half of that, plus r into float (1.5) and the
+// correction back into z (1.5): 26.85. Coarser levels add 1/8 + 1/64 + ... ≈ 1/7.
+constexpr double MULTIGRID_DOUBLES = (47.7 / 2.0 + 3.0) * 8.0 / 7.0;
 // Eigen IC-CG, per row: CSR A·p with 7 entries of 8-byte values and 4-byte indices (84 B) plus
 // p and q (16 B); two triangular solves with the IC factor (≈ 4 entries per row each, 96 B,
 // plus 32 B of vectors); CG vector updates and dots (≈ 10 vectors, 80 B): about 308 B.

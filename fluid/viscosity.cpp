@@ -352,8 +352,13 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         while (!result.converged && result.iterations < options.iteration.max_iterations) {
             options.iteration.cancel.throw_if_requested("the viscosity solve");
             refresh_ghosts(p);
-            op.apply(p, q);
-            const double curvature = global_dot(p, q);
+            double curvature = 0.0;
+            if (distributed) {
+                op.apply(p, q);
+                curvature = global_dot(p, q);
+            } else {
+                curvature = op.apply_dot(p, q);  // p·q from the same pass
+            }
             if (!(curvature > 0.0)) {
                 break;
             }

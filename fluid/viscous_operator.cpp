@@ -2,9 +2,11 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "fluid/surface_viscosity.h"
 
@@ -12,6 +14,8 @@ namespace meniscus::fluid {
 
 namespace {
 
+/// Faces per task of apply_dot()'s sum: dot()'s split (poisson_matrix.cpp), so the same value.
+constexpr std::size_t DOT_GRAIN = 16384;
 /// Weight of a shear strain-rate term: 2 μ ε_ab² = ½ μ (∂_b u_a + ∂_a u_b)².
 constexpr double SHEAR_WEIGHT = 0.5;
 constexpr double HALF = 0.5;
@@ -131,6 +135,20 @@ void ViscousOperator::apply(const std::vector<double>& x, std::vector<double>& y
                           for (std::size_t f = r.begin(); f != r.end(); ++f)
                               y[f] = m_unknown[f] ? y[f] + m_density[f] * x[f] : 0.0;
                       });
+}
+
+double ViscousOperator::apply_dot(const std::vector<double>& x, std::vector<double>& y) const {
+    stiffness(x, y);
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, m_size, DOT_GRAIN), 0.0,
+        [&](const tbb::blocked_range<std::size_t>& r, double sum) {
+            for (std::size_t f = r.begin(); f != r.end(); ++f) {
+                y[f] = m_unknown[f] ? y[f] + m_density[f] * x[f] : 0.0;
+                sum += x[f] * y[f];
+            }
+            return sum;
+        },
+        std::plus<double>());
 }
 
 void ViscousOperator::diagonal(std::vector<double>& d, bool with_surface) const {

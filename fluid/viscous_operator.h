@@ -50,6 +50,8 @@ public:
 
     /// y = (ρ + K) x restricted to the unknowns (x must vanish on fixed faces; y does too).
     void apply(const std::vector<double>& x, std::vector<double>& y) const;
+    /// apply(), returning x·y from its last pass (summed as dot() sums, so the same value).
+    double apply_dot(const std::vector<double>& x, std::vector<double>& y) const;
 
     /// Diagonal of ρ + K on the unknowns (1 on fixed faces), for Jacobi preconditioning; with
     /// `with_surface` false, that of the grid part alone (the surface term's left out, for
