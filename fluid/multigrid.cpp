@@ -71,6 +71,11 @@ void take_seam_planes(const BasicPoissonMatrix<T>& a, const std::vector<T>& x,
     }
 }
 
+/// Cells per chunk of smooth_plane()'s vectorised rows (even, so that a chunk starts on the
+/// row's parity).
+constexpr int SMOOTH_CHUNK = 256;
+static_assert(SMOOTH_CHUNK % 2 == 0, "a chunk must start on an even cell");
+
 /// One red–black Gauss–Seidel half sweep over the cells of plane k with (i + j + k) % 2 ==
 /// colour. Neighbours across a periodic seam are read from `seams` (take_seam_planes() of x
 /// before the half sweep). `Wrap` false compiles the loop without the seam's branches.
@@ -97,12 +102,24 @@ void smooth_plane(const BasicPoissonMatrix<T>& a, const std::vector<T>& inverse,
             // cells read there lie inside the array, so the x-neighbours need no test.
             // No test for inactive cells either: their inverse diagonal is 0 (and b, x are 0
             // there), and the three pairs summed apart shorten the chain of dependent adds.
-            for (int i = (j + k + colour) % 2; i < ni; i += 2) {
-                const std::size_t c = row + i;
-                const T along_x = a_x[c] * xv[c + 1] + a_x[c - 1] * xv[c - 1];
-                const T along_y = a_y[c] * xv[c + sj] + a_y[c - sj] * xv[c - sj];
-                const T along_z = a_z[c] * xv[c + sk] + a_z[c - sk] * xv[c - sk];
-                xv[c] = (bv[c] - (along_x + along_y + along_z)) * iv[c];
+            // The update is computed for every cell of a chunk of the row into `fresh` (a loop
+            // over contiguous cells that vectorises; a stride-2 loop does not), then only this
+            // colour's cells are stored: they read only the other colour, which this half sweep
+            // leaves as it is, so the result is that of the stride-2 loop, bit for bit.
+            const int first = (j + k + colour) % 2;
+            for (int i0 = 0; i0 < ni; i0 += SMOOTH_CHUNK) {
+                const int len = std::min(SMOOTH_CHUNK, ni - i0);
+                const std::size_t c0 = row + static_cast<std::size_t>(i0);
+                T fresh[SMOOTH_CHUNK];
+                for (int t = 0; t < len; ++t) {
+                    const std::size_t c = c0 + static_cast<std::size_t>(t);
+                    const T along_x = a_x[c] * xv[c + 1] + a_x[c - 1] * xv[c - 1];
+                    const T along_y = a_y[c] * xv[c + sj] + a_y[c - sj] * xv[c - sj];
+                    const T along_z = a_z[c] * xv[c + sk] + a_z[c - sk] * xv[c - sk];
+                    fresh[t] = (bv[c] - (along_x + along_y + along_z)) * iv[c];
+                }
+                for (int t = first; t < len; t += 2)  // i0 is even: the colour's parity holds
+                    xv[c0 + static_cast<std::size_t>(t)] = fresh[t];
             }
             continue;
         }
