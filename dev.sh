@@ -25,15 +25,15 @@ SANITIZE_BUILD_DIR=${MENISCUS_SANITIZE_BUILD_DIR:-build-sanitize}
 # 2 oversubscribed cores, the static drop on 2 and 3 ranks and the distributed grid's checks on 2
 # ranks stay in; the checkpoint round trip over 1-3 ranks (272 s there, 26 s in the Release suite)
 # and the grid's checks on 3 ranks (146 s) run in the Release suite only.
-SANITIZE_EXCLUDE='QuickValidation|SceneRuns|ScenePhysics|PeriodicScenes\.(RayleighPlateau|ColumnShorter)|FlowScenes\.(ShrinkingSphere|ThinSheet|CurlNoiseStretches)'
-SANITIZE_EXCLUDE+='|CollisionStress\.(SphereCrushed|SpheresDrivenHeadOn)|CollisionRegression|MeanCurvature\.JustPinched'
-SANITIZE_EXCLUDE+='|AxisymmetricDumbbell\.(Agrees|Converges|HandlePinches)|AxisymmetricMcfReference\.SphereShrinks'
-SANITIZE_EXCLUDE+='|LevelSetReference\.(SphereFollows|DumbbellPinches)|Simulation\.(MergedDrop|StaticDropSpurious)'
-SANITIZE_EXCLUDE+='|CcdFalsePositives\.NearDegenerate|RemeshAccuracy\.SplitsAtThinFolds|FluidViscosity\.(TwoLayer|Poiseuille)'
-SANITIZE_EXCLUDE+='|MovingWalls\.LidOverAClosedChannel|FluidSolver\.TaylorGreenVortexDecay|DropMerge\.TwoDrops|SurfaceTension\.(StaticDropThrough|SmoothingReduces)'
+SANITIZE_EXCLUDE='QuickValidation|SceneRuns|ScenePhysics|PeriodicScenes\.RayleighPlateau|PeriodicScenes\.ColumnShorter|FlowScenes\.ShrinkingSphere|FlowScenes\.ThinSheet|FlowScenes\.CurlNoiseStretches'
+SANITIZE_EXCLUDE+='|CollisionStress\.SphereCrushed|CollisionStress\.SpheresDrivenHeadOn|CollisionRegression|MeanCurvature\.JustPinched'
+SANITIZE_EXCLUDE+='|AxisymmetricDumbbell\.Agrees|AxisymmetricDumbbell\.Converges|AxisymmetricDumbbell\.HandlePinches|AxisymmetricMcfReference\.SphereShrinks'
+SANITIZE_EXCLUDE+='|LevelSetReference\.SphereFollows|LevelSetReference\.DumbbellPinches|Simulation\.MergedDrop|Simulation\.StaticDropSpurious'
+SANITIZE_EXCLUDE+='|CcdFalsePositives\.NearDegenerate|RemeshAccuracy\.SplitsAtThinFolds|FluidViscosity\.TwoLayer|FluidViscosity\.Poiseuille'
+SANITIZE_EXCLUDE+='|MovingWalls\.LidOverAClosedChannel|FluidSolver\.TaylorGreenVortexDecay|DropMerge\.TwoDrops|SurfaceTension\.StaticDropThrough|SurfaceTension\.SmoothingReduces'
 SANITIZE_EXCLUDE+='|FuzzRun.*/[1-6]$|RenderPath|FluidScenes\.TimeDtCapsTheFluidStep'
-SANITIZE_EXCLUDE+='|Resume\.(FluidRunKilled|GeometricFlowKilled|OneAndTwoThreads)'
-SANITIZE_EXCLUDE+='|DistributedRun\.(BubbleMerge|JetPinch|CheckpointsResume)|DistributedGrid\.mpirun_3_ranks'
+SANITIZE_EXCLUDE+='|Resume\.FluidRunKilled|Resume\.GeometricFlowKilled|Resume\.OneAndTwoThreads'
+SANITIZE_EXCLUDE+='|DistributedRun\.BubbleMerge|DistributedRun\.JetPinch|DistributedRun\.CheckpointsResume|DistributedGrid\.mpirun_3_ranks'
 # Cases that start MPI in their process (an MPI singleton: the distributed grid and every hypre
 # solve) sometimes end with LeakSanitizer's own tracer crashing at exit after the tests passed
 # ("Tracer caught signal 11", 10 of them in one full sanitize run, none in 33 runs of them by
@@ -100,9 +100,18 @@ run_ctest() {
 cmd=${1:-run}
 shift || true
 install_missing
+# ctest -N's count of the tests a selection leaves.
+count_tests() { ctest -N "$@" | sed -n 's/^Total Tests: //p'; }
+
 if [ "$cmd" = sanitize ]; then
   sanitize_build
   cd "$SANITIZE_BUILD_DIR"
+  # ctest's regular expressions take at most 9 groups in parentheses; past that (or with any
+  # other error) -E matches nothing and the pass would silently run the whole suite.
+  if [ "$(count_tests -E "$SANITIZE_EXCLUDE|$SANITIZE_RETRIED")" = "$(count_tests)" ]; then
+    echo "dev.sh: SANITIZE_EXCLUDE leaves out no test (is it a regular expression ctest takes?)" >&2
+    exit 2
+  fi
   rc=0
   run_ctest --timeout 1800 -E "$SANITIZE_EXCLUDE|$SANITIZE_RETRIED" || rc=$?
   run_ctest --timeout 1800 -R "$SANITIZE_RETRIED" -E "$SANITIZE_EXCLUDE" --repeat until-pass:3 || rc=$?
