@@ -81,7 +81,7 @@ TEST(RankCommunicator, WorldSumsAndExchanges) {
 /// create the desired directory", once in a `./dev.sh test` run two tests at a time). A plain
 /// run now has a directory of its own.
 TEST(RankCommunicator, APlainRunKeepsItsMpiSessionFilesInADirectoryOfItsOwn) {
-    const RankCommunicator world = ranks();
+    [[maybe_unused]] const RankCommunicator world = ranks();  // starts MPI
     if (launched_by_mpi_launcher())
         GTEST_SKIP() << "under mpirun the launcher's set-up is left alone";
     const char* base = std::getenv("OMPI_MCA_orte_tmpdir_base");
