@@ -17,7 +17,8 @@
 // (rasterize, curvature, fluid, interpolate, volume_correction, tracker), the fluid step's
 // (advection, forces, viscosity, pressure_build, pressure_solve, extrapolation) and the total;
 // pcg_its, visc_cg_its, passes: pressure PCG and viscous CG iterations and the coupled scheme's
-// Uzawa passes, per step. A second table sets a memory traffic model of advection, viscosity and
+// Uzawa passes, per step (pass_pcg_its, pass_visc_cg_its: those of the passes, on their region).
+// A second table sets a memory traffic model of advection, viscosity and
 // the pressure solve over the measured stream copy bandwidth beside the measured CPU time.
 // CPU is the process's (all threads), so at 2 threads CPU ≈ 2 × wall when both are busy. After
 // the run a table of the same figures is printed, one column per benchmark.
@@ -189,6 +190,7 @@ void coupled_steps(benchmark::State& state, const app::Scene& scene, int warmup_
     PhaseTotals totals;
     double dt = 0.0;
     long long steps = 0, pressure_iterations = 0, viscosity_iterations = 0, passes = 0;
+    long long pass_pressure_iterations = 0, pass_viscosity_iterations = 0;
     double model_pressure = 0.0, model_viscosity = 0.0;
     for (auto _ : state) {
         const coupling::SimulationStepReport report = sim->step(scene.time.dt);
@@ -204,6 +206,8 @@ void coupled_steps(benchmark::State& state, const app::Scene& scene, int warmup_
         model_viscosity += report.fluid.viscosity.iterations +
                            (share - 1.0) * report.fluid.pass_viscosity_iterations;
         passes += report.fluid.passes;
+        pass_pressure_iterations += report.fluid.pass_pressure_iterations;
+        pass_viscosity_iterations += report.fluid.pass_viscosity_iterations;
         ++steps;
     }
     const double per = 1e6 / (cells * static_cast<double>(std::max<long long>(steps, 1)));
@@ -219,6 +223,8 @@ void coupled_steps(benchmark::State& state, const app::Scene& scene, int warmup_
     state.counters["dt_s"] = dt / n;
     state.counters["pcg_its"] = static_cast<double>(pressure_iterations) / n;
     state.counters["visc_cg_its"] = static_cast<double>(viscosity_iterations) / n;
+    state.counters["pass_pcg_its"] = static_cast<double>(pass_pressure_iterations) / n;
+    state.counters["pass_visc_cg_its"] = static_cast<double>(pass_viscosity_iterations) / n;
     ModelInputs inputs;
     inputs.label = label;
     inputs.pressure_iterations = model_pressure / n;

@@ -129,15 +129,17 @@ void ViscousOperator::stiffness(const std::vector<double>& x, std::vector<double
 }
 
 void ViscousOperator::apply(const std::vector<double>& x, std::vector<double>& y) const {
-    stiffness(x, y);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_size),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t f = r.begin(); f != r.end(); ++f)
-                              y[f] = m_unknown[f] ? y[f] + m_density[f] * x[f] : 0.0;
-                      });
+    apply_dot(x, y);
 }
 
 double ViscousOperator::apply_dot(const std::vector<double>& x, std::vector<double>& y) const {
+    if (!m_surface) {
+        // The mass term, the restriction to the unknowns and x·y in the divergence's own pass.
+        y.resize(m_size);
+        normal_stresses(x);
+        shear_stresses(x, nullptr);
+        return stress_divergence(y, &x);
+    }
     stiffness(x, y);
     return tbb::parallel_deterministic_reduce(
         tbb::blocked_range<std::size_t>(0, m_size, DOT_GRAIN), 0.0,
@@ -155,10 +157,75 @@ void ViscousOperator::diagonal(std::vector<double>& d, bool with_surface) const 
     d.assign(m_size, 1.0);
     const double inv_dx2 = 1.0 / (m_dx * m_dx);
     for (int a = 0; a < 3; ++a) {
+        // The faces whose cells and edges are all inside the box (no wall, seam or outflow):
+        // the general case's operations in the same order, by flat index along the rows.
+        const Index3& dims = m_face_dims[a];
+        const std::size_t cell_step = a == 0   ? 1
+                                      : a == 1 ? static_cast<std::size_t>(m_n[0])
+                                               : static_cast<std::size_t>(m_n[0]) * m_n[1];
+        std::array<int, 2> other{};
+        std::array<std::size_t, 2> edge_step{};
+        for (int b = 0, t = 0; b < 3; ++b) {
+            if (b == a)
+                continue;
+            const Array3<double>& weight = m_edge_weight[3 - a - b];
+            other[t] = b;
+            edge_step[t] = b == 0   ? 1
+                           : b == 1 ? static_cast<std::size_t>(weight.ni())
+                                    : static_cast<std::size_t>(weight.ni()) * weight.nj();
+            ++t;
+        }
+        const double* mu = m_mu.data();
+        const double* weight0 = m_edge_weight[3 - a - other[0]].data();
+        const double* weight1 = m_edge_weight[3 - a - other[1]].data();
+        const double edge_scale = 2.0 * m_dt * inv_dx2;
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, dims[2]), [&](const tbb::blocked_range<int>& r) {
+                for (int k = r.begin(); k != r.end(); ++k)
+                    for (int j = 0; j < dims[1]; ++j) {
+                        const Index3 row = {0, j, k};
+                        bool inside = true;
+                        for (int axis = 1; axis < 3; ++axis) {
+                            const int limit = axis == a ? m_n[a] - 1 : m_n[axis] - 2;
+                            inside = inside && row[axis] >= 1 && row[axis] <= limit;
+                        }
+                        if (!inside)
+                            continue;
+                        const int end = a == 0 ? m_n[0] : m_n[0] - 1;
+                        const std::size_t face_row = face_flat(a, row);
+                        const std::size_t cell_row =
+                            static_cast<std::size_t>(m_n[0]) *
+                            (static_cast<std::size_t>(j) + static_cast<std::size_t>(m_n[1]) * k);
+                        const std::size_t edge_row0 =
+                            m_edge_weight[3 - a - other[0]].index(0, j, k);
+                        const std::size_t edge_row1 =
+                            m_edge_weight[3 - a - other[1]].index(0, j, k);
+                        for (int i = 1; i < end; ++i) {
+                            const std::size_t flat = face_row + static_cast<std::size_t>(i);
+                            if (!m_unknown[flat])
+                                continue;
+                            const std::size_t cell = cell_row + static_cast<std::size_t>(i);
+                            double sum = m_density[flat] +
+                                         2.0 * m_dt * (mu[cell - cell_step] + mu[cell]) * inv_dx2;
+                            const std::size_t e0 = edge_row0 + static_cast<std::size_t>(i);
+                            sum += edge_scale * (weight0[e0] + weight0[e0 + edge_step[0]]);
+                            const std::size_t e1 = edge_row1 + static_cast<std::size_t>(i);
+                            sum += edge_scale * (weight1[e1] + weight1[e1 + edge_step[1]]);
+                            d[flat] = sum;
+                        }
+                    }
+            });
         for_each_face(a, [&](const Index3& f, std::size_t flat) {
             if (!m_unknown[flat]) {
                 return;
             }
+            bool inside = true;  // done above
+            for (int axis = 0; axis < 3; ++axis) {
+                const int limit = axis == a ? m_n[a] - 1 : m_n[axis] - 2;
+                inside = inside && f[axis] >= 1 && f[axis] <= limit;
+            }
+            if (inside)
+                return;
             Index3 lo = f;
             --lo[a];
             // An outflow face has its cell on one side only.
@@ -463,8 +530,25 @@ void ViscousOperator::shear_stresses(const std::vector<double>& x,
     }
 }
 
-void ViscousOperator::stress_divergence(std::vector<double>& y) const {
+double ViscousOperator::stress_divergence(std::vector<double>& y,
+                                          const std::vector<double>* x) const {
     const double inv_dx = 1.0 / m_dx;
+    // With x: y_f = ρ_f x_f + (K x)_f on the unknowns, 0 elsewhere, and x·y summed per face
+    // layer (each layer in its own order, the layers in theirs: the same for any thread count).
+    const char* unknown = m_unknown.data();
+    const double* density = m_density.data();
+    const double* xs = x ? x->data() : nullptr;
+    const auto finish = [&](std::size_t flat, double sum, double& dot) {
+        if (!xs)
+            return sum;
+        const double value = unknown[flat] ? sum + density[flat] * xs[flat] : 0.0;
+        dot += xs[flat] * value;
+        return value;
+    };
+    std::vector<double>& layer_dots = m_layer_dots;
+    layer_dots.assign(
+        static_cast<std::size_t>(m_face_dims[0][2] + m_face_dims[1][2] + m_face_dims[2][2]), 0.0);
+    std::size_t layer_offset = 0;
     for (int a = 0; a < 3; ++a) {
         const Array3<double>& sigma = m_normal_stress[a];
         const Index3& dims = m_face_dims[a];
@@ -488,6 +572,7 @@ void ViscousOperator::stress_divergence(std::vector<double>& y) const {
         tbb::parallel_for(
             tbb::blocked_range<int>(0, dims[2]), [&](const tbb::blocked_range<int>& r) {
                 for (int k = r.begin(); k != r.end(); ++k) {
+                    double layer_dot = 0.0;
                     for (int j = 0; j < dims[1]; ++j) {
                         const std::size_t face_row = face_flat(a, {0, j, k});
                         // The faces of the row whose cells, below and above, and edges, below
@@ -519,7 +604,7 @@ void ViscousOperator::stress_divergence(std::vector<double>& y) const {
                             sum += tau0[below0] * inv_dx + tau0[below0 + edge_step[0]] * -inv_dx;
                             const std::size_t below1 = tau1_row + static_cast<std::size_t>(i);
                             sum += tau1[below1] * inv_dx + tau1[below1 + edge_step[1]] * -inv_dx;
-                            y[face_row + i] = sum;
+                            y[face_row + i] = finish(face_row + i, sum, layer_dot);
                         }
                         for (int i = 0; i < dims[0]; ++i) {
                             if (i == fast_begin)
@@ -527,8 +612,11 @@ void ViscousOperator::stress_divergence(std::vector<double>& y) const {
                             if (i >= dims[0])
                                 break;
                             const Index3 f = {i, j, k};
-                            if (!solvable(a, f))
+                            if (!solvable(a, f)) {
+                                if (xs)
+                                    y[face_row + i] = 0.0;
                                 continue;
+                            }
                             // Cell f lies above the face, cell f − e_a below it (an outflow
                             // face has one of them). The flat index of f is formed without
                             // the array's bounds: on the max face only cell − step is read.
@@ -559,12 +647,18 @@ void ViscousOperator::stress_divergence(std::vector<double>& y) const {
                                     -(last && !wrap ? MIRROR_FACTOR : 1.0) * inv_dx;
                                 sum += tau[below] * c_below + tau[above] * c_above;
                             }
-                            y[face_row + i] = sum;
+                            y[face_row + i] = finish(face_row + i, sum, layer_dot);
                         }
                     }
+                    layer_dots[layer_offset + static_cast<std::size_t>(k)] = layer_dot;
                 }
             });
+        layer_offset += static_cast<std::size_t>(dims[2]);
     }
+    double total = 0.0;
+    for (const double d : layer_dots)
+        total += d;
+    return total;
 }
 
 }  // namespace meniscus::fluid

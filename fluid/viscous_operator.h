@@ -50,7 +50,9 @@ public:
 
     /// y = (ρ + K) x restricted to the unknowns (x must vanish on fixed faces; y does too).
     void apply(const std::vector<double>& x, std::vector<double>& y) const;
-    /// apply(), returning x·y from its last pass (summed as dot() sums, so the same value).
+    /// apply(), returning x·y from its last pass: summed per face layer (each layer along its
+    /// rows, then the layers in order; without a surface term), so the same for any number of
+    /// threads, equal to dot() to round-off.
     double apply_dot(const std::vector<double>& x, std::vector<double>& y) const;
 
     /// Diagonal of ρ + K on the unknowns (1 on fixed faces), for Jacobi preconditioning; with
@@ -118,8 +120,10 @@ private:
     /// of recomputed.
     void shear_stresses(const std::vector<double>& x, const BoundaryOptions* moving) const;
 
-    /// y_f = Σ over the strain terms containing face f of stress × coefficient.
-    void stress_divergence(std::vector<double>& y) const;
+    /// y_f = Σ over the strain terms containing face f of stress × coefficient. With `x`, the
+    /// whole operator instead: y_f = ρ_f x_f + that sum on the unknowns and 0 on every other face
+    /// (apply()), returning x·y summed per face layer; without, 0.
+    double stress_divergence(std::vector<double>& y, const std::vector<double>* x = nullptr) const;
 
     Index3 m_n{};
     bool m_open[3][2] = {};  ///< outflow faces of the box: their normal velocity is solved for
@@ -143,6 +147,7 @@ private:
     std::vector<double> m_density;                ///< ρ_f on unknown faces
     mutable std::array<Array3<double>, 3> m_normal_stress;  ///< scratch: σ_aa at cells
     mutable std::array<Array3<double>, 3> m_shear_stress;   ///< scratch: τ on edges
+    mutable std::vector<double> m_layer_dots;  ///< scratch: apply_dot()'s sum per face layer
 };
 
 }  // namespace meniscus::fluid
