@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <utility>
 
 #include "fluid/surface_viscosity.h"
 
@@ -503,7 +504,29 @@ void ViscousOperator::shear_stresses(const std::vector<double>& x,
                         const std::size_t row_a = face_flat(a, {0, j, k});
                         const std::size_t row_b = face_flat(b, {0, j, k});
                         const std::size_t edge_row = weight.index(0, j, k);
+                        // The edges of the row whose derivatives reach no wall, seam or
+                        // outflow (i in [fast_begin, fast_end)): both differences inside.
+                        const Index3 row = {0, j, k};
+                        bool inside = true;
+                        for (const auto& [axis, n_axis] : {std::pair{a, n_a}, std::pair{b, n_b}})
+                            if (axis != 0)
+                                inside = inside && row[axis] >= 1 && row[axis] <= n_axis - 1;
+                        const int fast_begin = !inside ? weight.ni() : (a == 0 || b == 0 ? 1 : 0);
+                        const int fast_end = !inside ? weight.ni() : m_n[0];
+                        for (int i = fast_begin; i < fast_end; ++i) {
+                            // Same operations, in the same order, as the general case below.
+                            const double w = weight[edge_row + i];
+                            const std::size_t fa = row_a + i;
+                            const std::size_t fb = row_b + i;
+                            const double d_ab = (x[fa] - x[fa - step_a]) / m_dx;
+                            const double d_ba = (x[fb] - x[fb - step_b]) / m_dx;
+                            tau[edge_row + i] = w == 0.0 ? 0.0 : 2.0 * m_dt * w * (d_ab + d_ba);
+                        }
                         for (int i = 0; i < weight.ni(); ++i) {
+                            if (i == fast_begin)
+                                i = fast_end;  // done above
+                            if (i >= weight.ni())
+                                break;
                             const double w = weight[edge_row + i];
                             if (w == 0.0) {
                                 tau[edge_row + i] = 0.0;
