@@ -95,11 +95,11 @@ app::Scene bubble_pair_cube(int cells) {
 // lower, upper, φ0 out) 8: 6 + 3 × 20 = 66.
 constexpr double ADVECTION_DOUBLES = 66.0;
 // Viscosity per CG iteration (3 face arrays, so 3 doubles per cell per vector): the operator
-// (normal stresses 9, shear stresses 12, their divergence 12, the mass term 12.4), p·q 6, the
-// fused update 24, p = z + βp 9: 84. Per step besides: the operator's build (μ, edge weights,
+// (normal stresses 9, shear stresses 12, their divergence with the mass term, the mask and p·q
+// 18.4), the fused update 24, p = z + βp 9: 72. Per step besides: the operator's build (μ, edge weights,
 // face densities and masks, its scratch) 28, the diagonal 12, u* split and b 64, the first
 // residual 63, the result 15: about 180.
-constexpr double VISCOSITY_ITERATION_DOUBLES = 84.0;
+constexpr double VISCOSITY_ITERATION_DOUBLES = 72.0;
 constexpr double VISCOSITY_STEP_DOUBLES = 180.0;
 // Pressure per PCG iteration: the PCG core 18 (four fused passes: A·p with p·q 6, the x and r
 // updates with r·r 6, r·z 2, the new direction 4) and one V-cycle in float 30.7
