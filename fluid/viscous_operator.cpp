@@ -154,6 +154,34 @@ double ViscousOperator::apply_dot(const std::vector<double>& x, std::vector<doub
         std::plus<double>());
 }
 
+ViscousOperator::FaceReach ViscousOperator::face_reach(int a) const {
+    FaceReach reach;
+    reach.cell_step = a == 0   ? 1
+                      : a == 1 ? static_cast<std::size_t>(m_n[0])
+                               : static_cast<std::size_t>(m_n[0]) * m_n[1];
+    for (int b = 0, t = 0; b < 3; ++b) {
+        if (b == a)
+            continue;
+        const Array3<double>& edges = m_edge_weight[3 - a - b];
+        reach.other[t] = b;
+        reach.edge_step[t] = b == 0   ? 1
+                             : b == 1 ? static_cast<std::size_t>(edges.ni())
+                                      : static_cast<std::size_t>(edges.ni()) * edges.nj();
+        ++t;
+    }
+    return reach;
+}
+
+bool ViscousOperator::row_inside(int a, int j, int k) const {
+    const Index3 row = {0, j, k};
+    bool inside = true;
+    for (int axis = 1; axis < 3; ++axis) {
+        const int limit = axis == a ? m_n[a] - 1 : m_n[axis] - 2;
+        inside = inside && row[axis] >= 1 && row[axis] <= limit;
+    }
+    return inside;
+}
+
 void ViscousOperator::diagonal(std::vector<double>& d, bool with_surface) const {
     d.assign(m_size, 1.0);
     const double inv_dx2 = 1.0 / (m_dx * m_dx);
@@ -161,21 +189,10 @@ void ViscousOperator::diagonal(std::vector<double>& d, bool with_surface) const 
         // The faces whose cells and edges are all inside the box (no wall, seam or outflow):
         // the general case's operations in the same order, by flat index along the rows.
         const Index3& dims = m_face_dims[a];
-        const std::size_t cell_step = a == 0   ? 1
-                                      : a == 1 ? static_cast<std::size_t>(m_n[0])
-                                               : static_cast<std::size_t>(m_n[0]) * m_n[1];
-        std::array<int, 2> other{};
-        std::array<std::size_t, 2> edge_step{};
-        for (int b = 0, t = 0; b < 3; ++b) {
-            if (b == a)
-                continue;
-            const Array3<double>& weight = m_edge_weight[3 - a - b];
-            other[t] = b;
-            edge_step[t] = b == 0   ? 1
-                           : b == 1 ? static_cast<std::size_t>(weight.ni())
-                                    : static_cast<std::size_t>(weight.ni()) * weight.nj();
-            ++t;
-        }
+        const FaceReach reach = face_reach(a);
+        const std::size_t cell_step = reach.cell_step;
+        const std::array<int, 2>& other = reach.other;
+        const std::array<std::size_t, 2>& edge_step = reach.edge_step;
         const double* mu = m_mu.data();
         const double* weight0 = m_edge_weight[3 - a - other[0]].data();
         const double* weight1 = m_edge_weight[3 - a - other[1]].data();
@@ -184,16 +201,10 @@ void ViscousOperator::diagonal(std::vector<double>& d, bool with_surface) const 
             tbb::blocked_range<int>(0, dims[2]), [&](const tbb::blocked_range<int>& r) {
                 for (int k = r.begin(); k != r.end(); ++k)
                     for (int j = 0; j < dims[1]; ++j) {
-                        const Index3 row = {0, j, k};
-                        bool inside = true;
-                        for (int axis = 1; axis < 3; ++axis) {
-                            const int limit = axis == a ? m_n[a] - 1 : m_n[axis] - 2;
-                            inside = inside && row[axis] >= 1 && row[axis] <= limit;
-                        }
-                        if (!inside)
+                        if (!row_inside(a, j, k))
                             continue;
                         const int end = a == 0 ? m_n[0] : m_n[0] - 1;
-                        const std::size_t face_row = face_flat(a, row);
+                        const std::size_t face_row = face_flat(a, {0, j, k});
                         const std::size_t cell_row =
                             static_cast<std::size_t>(m_n[0]) *
                             (static_cast<std::size_t>(j) + static_cast<std::size_t>(m_n[1]) * k);
@@ -220,13 +231,9 @@ void ViscousOperator::diagonal(std::vector<double>& d, bool with_surface) const 
             if (!m_unknown[flat]) {
                 return;
             }
-            bool inside = true;  // done above
-            for (int axis = 0; axis < 3; ++axis) {
-                const int limit = axis == a ? m_n[a] - 1 : m_n[axis] - 2;
-                inside = inside && f[axis] >= 1 && f[axis] <= limit;
-            }
-            if (inside)
-                return;
+            const int last = a == 0 ? m_n[0] - 1 : m_n[0] - 2;
+            if (f[0] >= 1 && f[0] <= last && row_inside(a, f[1], f[2]))
+                return;  // done above
             Index3 lo = f;
             --lo[a];
             // An outflow face has its cell on one side only.
@@ -575,23 +582,11 @@ double ViscousOperator::stress_divergence(std::vector<double>& y,
     for (int a = 0; a < 3; ++a) {
         const Array3<double>& sigma = m_normal_stress[a];
         const Index3& dims = m_face_dims[a];
-        const std::size_t cell_step = a == 0   ? 1
-                                      : a == 1 ? static_cast<std::size_t>(m_n[0])
-                                               : static_cast<std::size_t>(m_n[0]) * m_n[1];
         // The two shear arrays this component meets, in the order b = 0, 1, 2 (b ≠ a).
-        std::array<int, 2> other{};
-        std::array<std::size_t, 2> edge_step{};
-        int count = 0;
-        for (int b = 0; b < 3; ++b) {
-            if (b == a)
-                continue;
-            const Array3<double>& tau = m_shear_stress[3 - a - b];
-            other[count] = b;
-            edge_step[count] = b == 0   ? 1
-                               : b == 1 ? static_cast<std::size_t>(tau.ni())
-                                        : static_cast<std::size_t>(tau.ni()) * tau.nj();
-            ++count;
-        }
+        const FaceReach reach = face_reach(a);
+        const std::size_t cell_step = reach.cell_step;
+        const std::array<int, 2>& other = reach.other;
+        const std::array<std::size_t, 2>& edge_step = reach.edge_step;
         tbb::parallel_for(
             tbb::blocked_range<int>(0, dims[2]), [&](const tbb::blocked_range<int>& r) {
                 for (int k = r.begin(); k != r.end(); ++k) {
@@ -601,12 +596,7 @@ double ViscousOperator::stress_divergence(std::vector<double>& y,
                         // The faces of the row whose cells, below and above, and edges, below
                         // and above along both other axes, are all inside the box: no seam,
                         // wall or outflow to treat (i in [fast_begin, fast_end)).
-                        const Index3 row = {0, j, k};
-                        bool inside = true;
-                        for (int axis = 1; axis < 3; ++axis) {
-                            const int limit = axis == a ? m_n[a] - 1 : m_n[axis] - 2;
-                            inside = inside && row[axis] >= 1 && row[axis] <= limit;
-                        }
+                        const bool inside = row_inside(a, j, k);
                         const int fast_begin = inside ? 1 : dims[0];
                         const int fast_end =
                             inside ? std::max(fast_begin, a == 0 ? m_n[0] : m_n[0] - 1) : dims[0];

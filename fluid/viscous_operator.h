@@ -90,6 +90,18 @@ private:
                    (static_cast<std::size_t>(f[1]) + static_cast<std::size_t>(d[1]) * f[2]);
     }
 
+    /// What a face of component a reaches: the flat step to the cell below it (along a) and,
+    /// for its two edge arrays (3 − a − b, the other axes b in increasing order), b and the flat
+    /// step along b.
+    struct FaceReach {
+        std::size_t cell_step = 0;
+        std::array<int, 2> other{};
+        std::array<std::size_t, 2> edge_step{};
+    };
+    FaceReach face_reach(int a) const;
+    /// Do the faces of component a in row (·, j, k) have their cells and edges inside the box
+    /// along axes 1 and 2 (no wall, seam or outflow to treat there)?
+    bool row_inside(int a, int j, int k) const;
     /// Liquid fraction of a cube of edge dx centred where the level set is `phi`: exact for a
     /// plane parallel to a face, 1 and 0 a half cell inside and outside (free_surface weights).
     double control_volume_fraction(double phi) const;

@@ -459,19 +459,26 @@ TEST(FluidViscosity, MultigridAndHyprePreconditionersGiveTheJacobiAnswerInFewerI
     EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
+/// φ of a gas bubble of `radius` (m) at the centre of the grid's box (liquid outside, φ < 0).
+Array3<double> centred_bubble(const MacGrid& grid, double radius) {
+    Array3<double> phi(grid.nx(), grid.ny(), grid.nz());
+    const Eigen::Vector3d centre =
+        0.5 * grid.dx() * Eigen::Vector3d(grid.nx(), grid.ny(), grid.nz());
+    for (int k = 0; k < grid.nz(); ++k)
+        for (int j = 0; j < grid.ny(); ++j)
+            for (int i = 0; i < grid.nx(); ++i)
+                phi(i, j, k) = radius - (grid.cell_centre(i, j, k) - centre).norm();
+    return phi;
+}
+
 TEST(FluidViscosity, OperatorsDiagonalIsTheProductsOnTheUnitVectors) {
     // diagonal() (interior faces by rows, the rest face by face) against e_f · A e_f for every
     // face of a bubble in water: unknowns within round-off, fixed faces 1.
     const int n[3] = {9, 8, 7};
     const double dx = 1e-3;
     for (const BoundaryType wall : {BoundaryType::no_slip, BoundaryType::free_slip}) {
-        MacGrid grid(n[0], n[1], n[2], dx);
-        Array3<double> phi(n[0], n[1], n[2]);
-        const Eigen::Vector3d centre = 0.5 * dx * Eigen::Vector3d(n[0], n[1], n[2]);
-        for (int k = 0; k < n[2]; ++k)
-            for (int j = 0; j < n[1]; ++j)
-                for (int i = 0; i < n[0]; ++i)
-                    phi(i, j, k) = (grid.cell_centre(i, j, k) - centre).norm() - 2.6 * dx;
+        const MacGrid grid(n[0], n[1], n[2], dx);
+        const Array3<double> phi = centred_bubble(grid, 2.6 * dx);
         ViscousOperator op;
         op.build(grid, phi, PhaseOptions{}, FluidMode::two_phase, BoundaryOptions::all(wall), 1e-4,
                  DEFAULT_MIN_LIQUID_FRACTION, ViscosityWeights::pointwise, nullptr);
@@ -502,13 +509,8 @@ TEST(FluidViscosity, OperatorsFusedDotIsTheDotOfItsProduct) {
     // no-slip walls, odd sizes over several tasks).
     const int n[3] = {37, 29, 33};
     const double dx = 1e-3;
-    MacGrid grid(n[0], n[1], n[2], dx);
-    Array3<double> phi(n[0], n[1], n[2]);
-    const Eigen::Vector3d centre = 0.5 * dx * Eigen::Vector3d(n[0], n[1], n[2]);
-    for (int k = 0; k < n[2]; ++k)
-        for (int j = 0; j < n[1]; ++j)
-            for (int i = 0; i < n[0]; ++i)
-                phi(i, j, k) = 8.0 * dx - (grid.cell_centre(i, j, k) - centre).norm();
+    const MacGrid grid(n[0], n[1], n[2], dx);
+    const Array3<double> phi = centred_bubble(grid, 8.0 * dx);
     ViscousOperator op;
     op.build(grid, phi, PhaseOptions{}, FluidMode::two_phase,
              BoundaryOptions::all(BoundaryType::no_slip), 1e-4, DEFAULT_MIN_LIQUID_FRACTION,
