@@ -276,12 +276,22 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     op.gather(grid, ws.u_star);
     x.assign(n, 0.0);
     fixed.assign(n, 0.0);
+    bool fixed_at_rest = true;
     for (std::size_t f = 0; f < n; ++f) {
         (unknown[f] ? x[f] : fixed[f]) = ws.u_star[f];
+        fixed_at_rest = fixed_at_rest && fixed[f] == 0.0;
     }
-    op.stiffness(fixed, b, walls.moving() ? &walls : nullptr);
-    for (std::size_t f = 0; f < n; ++f) {
-        b[f] = unknown[f] ? density[f] * ws.u_star[f] - b[f] : 0.0;
+    if (fixed_at_rest && !walls.moving()) {
+        // K 0 = 0 (the map is linear without moving walls): b = ρ u* exactly, without the
+        // operator's three passes (two_phase in a box of walls at rest: every step).
+        b.resize(n);
+        for (std::size_t f = 0; f < n; ++f)
+            b[f] = unknown[f] ? density[f] * ws.u_star[f] : 0.0;
+    } else {
+        op.stiffness(fixed, b, walls.moving() ? &walls : nullptr);
+        for (std::size_t f = 0; f < n; ++f) {
+            b[f] = unknown[f] ? density[f] * ws.u_star[f] - b[f] : 0.0;
+        }
     }
     const double b_norm = std::sqrt(global_dot(b, b));
     if (b_norm == 0.0) {
