@@ -18,8 +18,8 @@
 // (advection, forces, viscosity, pressure_build, pressure_solve, extrapolation) and the total;
 // pcg_its, visc_cg_its, passes: pressure PCG and viscous CG iterations and the coupled scheme's
 // Uzawa passes, per step (pass_pcg_its, pass_visc_cg_its: those of the passes, on their region).
-// A second table sets a memory traffic model of advection, viscosity and
-// the pressure solve over the measured stream copy bandwidth beside the measured CPU time.
+// A second table sets a memory traffic model of advection, viscosity and the pressure solve over
+// the measured stream copy bandwidth beside the measured CPU time.
 // CPU is the process's (all threads), so at 2 threads CPU ≈ 2 × wall when both are busy. After
 // the run a table of the same figures is printed, one column per benchmark.
 //
@@ -96,8 +96,8 @@ app::Scene bubble_pair_cube(int cells) {
 constexpr double ADVECTION_DOUBLES = 66.0;
 // Viscosity per CG iteration (3 face arrays, so 3 doubles per cell per vector): the operator
 // (normal stresses 9, shear stresses 12, their divergence with the mass term, the mask and p·q
-// 18.4), the fused update 24, p = z + βp 9: 72. Per step besides: the operator's build (μ, edge weights,
-// face densities and masks, its scratch) 28, the diagonal 12, u* split and b 64, the first
+// 18.4), the fused update 24, p = z + βp 9: 72. Per step besides: the operator's build (μ, edge
+// weights, face densities and masks, its scratch) 28, the diagonal 12, u* split and b 64, the first
 // residual 63, the result 15: about 180.
 constexpr double VISCOSITY_ITERATION_DOUBLES = 72.0;
 constexpr double VISCOSITY_STEP_DOUBLES = 180.0;
