@@ -4,7 +4,7 @@
 // pressure with hypre (the distributed backend), so they differ only by where the sums are taken.
 // Checked per frame: the vertex positions within 1e-9 of the domain size, the same component counts
 // (the same merge and pinch frames), steps and volumes, the VDB pressure assembled from the blocks.
-// The positions are compared up to the first merge or pinch-off (see expect_same_run()).
+// The positions are compared up to the first merge or pinch-off (see expect_same_as_alone()).
 #include "child_process.h"
 
 #include <gtest/gtest.h>
@@ -107,16 +107,10 @@ std::pair<double, double> pressure_difference(const fs::path& a, const fs::path&
     return {difference, scale};
 }
 
-/// The one-process run of `scene` against the run on `ranks` ranks.
-void expect_same_run(const std::string& name, const Json& scene, int ranks,
-                     int expected_final_components) {
-    // One folder per case: ctest runs the tests of this program in parallel.
-    const fs::path dir = fs::temp_directory_path() /
-                         ("meniscus_distributed_run_" + name + "_" + std::to_string(ranks));
-    const fs::path alone = dir / (name + "_alone"),
-                   split = dir / (name + "_" + std::to_string(ranks));
-    const ChildResult a = run(scene, alone, 0);
-    ASSERT_TRUE(a.exited && a.exit_code == 0) << a.output;
+/// The one-process run of `scene` (`alone`, its result `a`) against the run on `ranks` ranks.
+void expect_same_as_alone(const std::string& name, const Json& scene, const fs::path& alone,
+                          const ChildResult& a, int ranks, int expected_final_components) {
+    const fs::path split = alone.parent_path() / (name + "_" + std::to_string(ranks));
     const ChildResult b = run(scene, split, ranks);
     ASSERT_TRUE(b.exited && b.exit_code == 0) << b.output;
     EXPECT_NE(b.output.find("split over " + std::to_string(ranks) + " MPI ranks"),
@@ -169,7 +163,28 @@ void expect_same_run(const std::string& name, const Json& scene, int ranks,
         EXPECT_GE(difference, 0.0) << "the VDB pressure grids' active voxels differ";
         EXPECT_LE(difference, 1e-6 * scale) << name;
     }
+}
+
+/// The one-process run of `scene` against the run on each of `rank_counts` (the one-process run
+/// made once).
+void expect_same_runs(const std::string& name, const Json& scene,
+                      const std::vector<int>& rank_counts, int expected_final_components) {
+    // One folder per case: ctest runs the tests of this program in parallel.
+    std::string folder = "meniscus_distributed_run_" + name;
+    for (const int ranks : rank_counts)
+        folder += "_" + std::to_string(ranks);
+    const fs::path dir = fs::temp_directory_path() / folder;
+    const fs::path alone = dir / (name + "_alone");
+    const ChildResult a = run(scene, alone, 0);
+    ASSERT_TRUE(a.exited && a.exit_code == 0) << a.output;
+    for (const int ranks : rank_counts)
+        expect_same_as_alone(name, scene, alone, a, ranks, expected_final_components);
     fs::remove_all(dir);
+}
+
+void expect_same_run(const std::string& name, const Json& scene, int ranks,
+                     int expected_final_components) {
+    expect_same_runs(name, scene, {ranks}, expected_final_components);
 }
 
 Json with_hypre(Json scene) {
@@ -201,8 +216,7 @@ TEST(DistributedRun, BubbleMergeMergesAtTheSameFrame) {
     Json scene = with_hypre(shipped_scene("bubble_merge"));
     scene["time"] = {{"end", 0.012}, {"frames", 12}};
     scene["output"] = {{"ply", true}, {"vdb", false}};
-    expect_same_run("bubble_merge", scene, 2, 1);
-    expect_same_run("bubble_merge", scene, 3, 1);
+    expect_same_runs("bubble_merge", scene, {2, 3}, 1);
 }
 
 TEST(DistributedRun, BubbleMergeWithTheViscousSolveOnHypre) {
@@ -293,8 +307,7 @@ TEST(DistributedRun, JetPinchPinchesAtTheSameFrame) {
     column["amplitude"] = 0.15;
     scene["time"] = {{"end", 0.014}, {"frames", 14}};
     scene["output"] = {{"ply", true}, {"vdb", false}};
-    expect_same_run("jet_pinch", scene, 2, 2);
-    expect_same_run("jet_pinch", scene, 3, 2);
+    expect_same_runs("jet_pinch", scene, {2, 3}, 2);
 }
 
 TEST(DistributedRun, RefusesWhatIsNotDistributedYet) {
