@@ -1,9 +1,14 @@
 #include "fluid/pressure.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "fluid/eigen_reference_solver.h"
 #include "fluid/pcg.h"
@@ -60,6 +65,61 @@ bool is_unknown(double phi, FluidMode mode) {
     return mode == FluidMode::two_phase || is_liquid(phi);
 }
 
+/// classify_face() with the faces between two cells of one phase, most of a grid's, taken from
+/// two couplings made once: the function depends on such a face's level set values only through
+/// their phase (its liquid fraction is 0 or 1, its jump 0), so the result is the same bit for bit.
+class FaceClassifier {
+public:
+    FaceClassifier(const PhaseOptions& phases, FluidMode mode, double min_liquid_fraction)
+        : m_phases(phases),
+          m_mode(mode),
+          m_min_liquid_fraction(min_liquid_fraction),
+          m_liquid(classify_face(-1.0, -1.0, 0.0, phases, mode, min_liquid_fraction)),
+          m_gas(classify_face(1.0, 1.0, 0.0, phases, mode, min_liquid_fraction)) {}
+
+    FaceCoupling operator()(double phi_lo, double phi_hi, double kappa) const {
+        const bool liquid_lo = is_liquid(phi_lo);
+        if (liquid_lo == is_liquid(phi_hi))
+            return liquid_lo ? m_liquid : m_gas;
+        return classify_face(phi_lo, phi_hi, kappa, m_phases, m_mode, m_min_liquid_fraction);
+    }
+
+private:
+    const PhaseOptions& m_phases;
+    FluidMode m_mode;
+    double m_min_liquid_fraction;
+    FaceCoupling m_liquid, m_gas;
+};
+
+/// MacGrid::divergence() of cell c = (i, j, k) (flat index) from the face arrays' storage, with
+/// the same operations in the same order, without its bounds checks.
+class FlatDivergence {
+public:
+    explicit FlatDivergence(const MacGrid& grid)
+        : m_u(grid.u().data()),
+          m_v(grid.v().data()),
+          m_w(grid.w().data()),
+          m_nx(static_cast<std::size_t>(grid.nx())),
+          m_ny(static_cast<std::size_t>(grid.ny())),
+          m_dx(grid.dx()) {}
+
+    double operator()(std::size_t c, int j, int k) const {
+        const std::size_t row = static_cast<std::size_t>(j) + m_ny * static_cast<std::size_t>(k);
+        const std::size_t i = c - m_nx * row;
+        const std::size_t u = i + (m_nx + 1) * row;             // u(i, j, k)
+        const std::size_t v = i + m_nx * (j + (m_ny + 1) * k);  // v(i, j, k)
+        return (m_u[u + 1] - m_u[u] + m_v[v + m_nx] - m_v[v] + m_w[c + m_nx * m_ny] - m_w[c]) /
+               m_dx;
+    }
+
+private:
+    const double* m_u;
+    const double* m_v;
+    const double* m_w;
+    std::size_t m_nx, m_ny;
+    double m_dx;
+};
+
 /// Calls visit(face index (i, j, k), lo cell (li, lj, lk)) for every face of component `axis`
 /// that lies strictly inside the box; the hi cell is (i, j, k). With a `periodic` axis the face
 /// on the min side is the seam between cell n−1 (lo) and cell 0 (hi), and is visited too (its
@@ -82,6 +142,40 @@ void for_each_interior_face(const MacGrid& grid, int axis, bool periodic, Visit&
             }
         }
     }
+}
+
+/// for_each_interior_face() by rows with flat indices, the rows of each k in parallel:
+/// visit(face index in the face array, lo cell, hi cell), the cells' flat indices. Only for
+/// visits that write nothing another face's visit reads or writes.
+template <class Visit>
+void parallel_for_each_interior_face(const MacGrid& grid, int axis, bool periodic, Visit&& visit) {
+    const Array3<double>& faces = grid.velocity(axis);
+    const int n_axis = grid.cells(axis);
+    const bool seam = periodic && n_axis > 1;
+    const std::size_t nx = static_cast<std::size_t>(grid.nx());
+    const std::size_t ny = static_cast<std::size_t>(grid.ny());
+    const std::size_t cell_step = axis == 0 ? 1 : (axis == 1 ? nx : nx * ny);
+    // The seam's lo cell is the last one along the axis.
+    const std::size_t seam_step = static_cast<std::size_t>(n_axis - 1) * cell_step;
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, faces.nk()), [&](const tbb::blocked_range<int>& r) {
+            for (int k = r.begin(); k != r.end(); ++k)
+                for (int j = 0; j < faces.nj(); ++j) {
+                    const int row_along = axis == 1 ? j : k;
+                    if (axis != 0 && ((row_along == 0 && !seam) || row_along == n_axis))
+                        continue;
+                    const std::size_t face_row = faces.index(0, j, k);
+                    const std::size_t cell_row = nx * (static_cast<std::size_t>(j) + ny * k);
+                    for (int i = 0; i < faces.ni(); ++i) {
+                        const int along = axis == 0 ? i : row_along;
+                        if ((along == 0 && !seam) || along == n_axis)
+                            continue;
+                        const std::size_t hi = cell_row + static_cast<std::size_t>(i);
+                        visit(face_row + static_cast<std::size_t>(i),
+                              along == 0 ? hi + seam_step : hi - cell_step, hi);
+                    }
+                }
+        });
 }
 
 /// Calls visit(axis, face index (i, j, k), the cell inside it, its coupling) for every boundary
@@ -171,6 +265,7 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
     PoissonMatrix& a = system.matrix;
     std::vector<double>& b = system.rhs;
     const Array3<double>& phi = interface.phi;
+    const FaceClassifier classify(phases, mode, options.min_liquid_fraction);
     bool has_dirichlet = false;
     for (int axis = 0; axis < 3; ++axis) {
         a.periodic[static_cast<std::size_t>(axis)] = boundaries.periodic(axis);
@@ -181,8 +276,7 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
                                    const std::size_t hi = phi.index(i, j, k);
                                    const std::size_t lo = phi.index(li, lj, lk);
                                    const FaceCoupling face =
-                                       classify_face(phi[lo], phi[hi], kappa(i, j, k), phases, mode,
-                                                     options.min_liquid_fraction);
+                                       classify(phi[lo], phi[hi], kappa(i, j, k));
                                    switch (face.kind) {
                                        case FaceCoupling::Kind::none:
                                            break;
@@ -213,6 +307,7 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
                               has_dirichlet = true;
                           });
     const double flux_scale = grid.dx() * grid.dx() / dt;
+    const FlatDivergence divergence(grid);
     for (int k = 0; k < nz; ++k) {
         for (int j = 0; j < ny; ++j) {
             for (int i = 0; i < nx; ++i) {
@@ -220,7 +315,7 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
                 if (!is_unknown(phi[c], mode)) {
                     continue;
                 }
-                b[c] -= flux_scale * grid.divergence(i, j, k);
+                b[c] -= flux_scale * divergence(c, j, k);
                 if (a.diag[c] <= 0.0) {
                     // An unknown cell with no open face (a 1-cell box): nothing to solve.
                     b[c] = 0.0;
@@ -330,17 +425,26 @@ void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
                              const PressureOptions& options, const Array3<double>& pressure,
                              const BoundaryOptions& boundaries) {
     const Array3<double>& phi = interface.phi;
+    const auto same_size = [](const Array3<double>& a, int ni, int nj, int nk) {
+        return a.ni() == ni && a.nj() == nj && a.nk() == nk;
+    };
+    if (!same_size(phi, grid.nx(), grid.ny(), grid.nz()) ||
+        !same_size(pressure, grid.nx(), grid.ny(), grid.nz()))
+        throw std::invalid_argument(
+            "apply_pressure_gradient: phi and pressure must have the grid's cell counts");
     const double scale = dt / grid.dx();
+    const FaceClassifier classify(phases, mode, options.min_liquid_fraction);
     for (int axis = 0; axis < 3; ++axis) {
         Array3<double>& velocity = grid.velocity(axis);
         const Array3<double>& kappa = interface.kappa(axis);
-        for_each_interior_face(
+        if (!same_size(kappa, velocity.ni(), velocity.nj(), velocity.nk()))
+            throw std::invalid_argument(
+                "apply_pressure_gradient: InterfaceInput.kappa_" + std::string(1, "uvw"[axis]) +
+                " must have the face counts of the grid's velocity component");
+        parallel_for_each_interior_face(
             grid, axis, boundaries.periodic(axis),
-            [&](int i, int j, int k, int li, int lj, int lk) {
-                const std::size_t hi = phi.index(i, j, k);
-                const std::size_t lo = phi.index(li, lj, lk);
-                const FaceCoupling face = classify_face(phi[lo], phi[hi], kappa(i, j, k), phases,
-                                                        mode, options.min_liquid_fraction);
+            [&](std::size_t f, std::size_t lo, std::size_t hi) {
+                const FaceCoupling face = classify(phi[lo], phi[hi], kappa[f]);
                 double difference = 0.0;  // p(hi) − p(lo) as seen from the unknown side(s), Pa
                 switch (face.kind) {
                     case FaceCoupling::Kind::none:
@@ -355,7 +459,7 @@ void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
                         difference = pressure[hi] - face.boundary_pressure;
                         break;
                 }
-                velocity(i, j, k) -= scale * face.beta * difference;
+                velocity[f] -= scale * face.beta * difference;
             });
         if (boundaries.periodic(axis))  // the seam's copy on the max side
             copy_seam_faces(velocity, axis);
@@ -372,17 +476,24 @@ void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
 }
 
 double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface, FluidMode mode) {
-    double largest = 0.0;
-    for (int k = 0; k < grid.nz(); ++k) {
-        for (int j = 0; j < grid.ny(); ++j) {
-            for (int i = 0; i < grid.nx(); ++i) {
-                if (is_unknown(interface.phi(i, j, k), mode)) {
-                    largest = std::max(largest, std::abs(grid.divergence(i, j, k)));
+    const Array3<double>& phi = interface.phi;
+    if (phi.ni() != grid.nx() || phi.nj() != grid.ny() || phi.nk() != grid.nz())
+        throw std::invalid_argument("max_fluid_divergence: phi must have the grid's cell counts");
+    const FlatDivergence divergence(grid);
+    // A largest value: the same whatever the split.
+    return tbb::parallel_reduce(
+        tbb::blocked_range<int>(0, grid.nz()), 0.0,
+        [&](const tbb::blocked_range<int>& r, double largest) {
+            for (int k = r.begin(); k != r.end(); ++k)
+                for (int j = 0; j < grid.ny(); ++j) {
+                    const std::size_t row = phi.index(0, j, k);
+                    for (std::size_t c = row; c != row + static_cast<std::size_t>(grid.nx()); ++c)
+                        if (is_unknown(phi[c], mode))
+                            largest = std::max(largest, std::abs(divergence(c, j, k)));
                 }
-            }
-        }
-    }
-    return largest;
+            return largest;
+        },
+        [](double a, double b) { return std::max(a, b); });
 }
 
 ProjectionResult project(MacGrid& grid, const InterfaceInput& interface, const PhaseOptions& phases,

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -708,6 +710,68 @@ TEST(FluidPressureOptions, ValidateNamesTheField) {
     } catch (const std::invalid_argument& error) {
         EXPECT_NE(std::string(error.what()).find("min_liquid_fraction"), std::string::npos);
     }
+}
+
+TEST(FluidPressure, LargestDivergenceIsTheGridsOverTheUnknownCells) {
+    // max_fluid_divergence() reads the face arrays by flat index: on a box of three different
+    // sizes, random velocities and a bubble, the same value bit for bit as MacGrid::divergence()
+    // over the unknown cells (every cell two-phase, the liquid ones with a free surface).
+    const int nx = 7, ny = 5, nz = 6;
+    MacGrid grid(nx, ny, nz, 0.1);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> random(-1.0, 1.0);
+    for (int axis = 0; axis < 3; ++axis)
+        for (double& value : grid.velocity(axis).storage())
+            value = random(rng);
+    InterfaceInput interface(grid);
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i)
+                interface.phi(i, j, k) =
+                    0.2 - (grid.cell_centre(i, j, k) - Eigen::Vector3d(0.3, 0.2, 0.35)).norm();
+    for (FluidMode mode : {FluidMode::two_phase, FluidMode::free_surface}) {
+        double largest = 0.0;
+        for (int k = 0; k < nz; ++k)
+            for (int j = 0; j < ny; ++j)
+                for (int i = 0; i < nx; ++i)
+                    if (mode == FluidMode::two_phase || interface.phi(i, j, k) < 0.0)
+                        largest = std::max(largest, std::abs(grid.divergence(i, j, k)));
+        EXPECT_GT(largest, 0.0);
+        EXPECT_EQ(max_fluid_divergence(grid, interface, mode), largest);
+    }
+}
+
+TEST(FluidPressure, GradientAndDivergenceRefuseArraysOfAnotherSize) {
+    MacGrid grid(6, 5, 4, 0.1);
+    const InterfaceInput interface(grid);
+    const PressureOptions options;
+    const auto message = [](const auto& call) {
+        try {
+            call();
+        } catch (const std::invalid_argument& error) {
+            return std::string(error.what());
+        }
+        return std::string("no exception");
+    };
+    const Array3<double> wrong(6, 5, 5, 0.0);
+    EXPECT_NE(message([&] {
+                  apply_pressure_gradient(grid, interface, PhaseOptions{}, FluidMode::two_phase,
+                                          1e-3, options, wrong, BoundaryOptions{});
+              }).find("pressure"),
+              std::string::npos);
+    InterfaceInput bad_kappa(grid);
+    bad_kappa.kappa_v.resize(6, 5, 4, 0.0);  // y-faces need ny + 1 = 6 along y
+    const Array3<double> pressure(6, 5, 4, 0.0);
+    EXPECT_NE(message([&] {
+                  apply_pressure_gradient(grid, bad_kappa, PhaseOptions{}, FluidMode::two_phase,
+                                          1e-3, options, pressure, BoundaryOptions{});
+              }).find("kappa_v"),
+              std::string::npos);
+    InterfaceInput bad_phi(grid);
+    bad_phi.phi = wrong;
+    EXPECT_NE(
+        message([&] { max_fluid_divergence(grid, bad_phi, FluidMode::two_phase); }).find("phi"),
+        std::string::npos);
 }
 
 }  // namespace
