@@ -414,6 +414,14 @@ void ViscousOperator::set_faces(const Array3<double>& phi, const PhaseOptions& p
                                 FluidMode mode, double min_liquid_fraction) {
     m_unknown.assign(m_size, 0);
     m_density.assign(m_size, 0.0);
+    // ρ_f of a face whose liquid fraction is θ; a face between two cells of one phase (θ exactly
+    // 1 or 0, most of the grid's) takes it from the two made once.
+    const auto density_of = [&](double theta) {
+        return mode == FluidMode::free_surface
+                   ? phases.rho_liquid * std::max(theta, min_liquid_fraction)
+                   : face_density(theta, phases, mode);
+    };
+    const double liquid_density = density_of(1.0), gas_density = density_of(0.0);
     for (int a = 0; a < 3; ++a) {
         for_each_face(a, [&](const Index3& f, std::size_t flat) {
             Index3 lo = f;
@@ -429,14 +437,15 @@ void ViscousOperator::set_faces(const Array3<double>& phi, const PhaseOptions& p
                 hi = lo;
             const double phi_lo = phi(lo[0], lo[1], lo[2]);
             const double phi_hi = phi(hi[0], hi[1], hi[2]);
-            if (mode == FluidMode::free_surface && !is_liquid(phi_lo) && !is_liquid(phi_hi)) {
+            const bool liquid_lo = is_liquid(phi_lo);
+            const bool liquid_hi = is_liquid(phi_hi);
+            if (mode == FluidMode::free_surface && !liquid_lo && !liquid_hi) {
                 return;
             }
             m_unknown[flat] = 1;
-            const double theta = liquid_fraction(phi_lo, phi_hi);
-            m_density[flat] = mode == FluidMode::free_surface
-                                  ? phases.rho_liquid * std::max(theta, min_liquid_fraction)
-                                  : face_density(theta, phases, mode);
+            m_density[flat] = liquid_lo != liquid_hi ? density_of(liquid_fraction(phi_lo, phi_hi))
+                              : liquid_lo            ? liquid_density
+                                                     : gas_density;
             // An outflow face's control volume is the half cell inside the box, like the
             // half dual cells of the shear terms on it and the pressure's distance Δx/2.
             if ((f[a] == 0 && !seam) || f[a] == m_n[a])
