@@ -120,35 +120,15 @@ private:
     double m_dx;
 };
 
-/// Calls visit(face index (i, j, k), lo cell (li, lj, lk)) for every face of component `axis`
-/// that lies strictly inside the box; the hi cell is (i, j, k). With a `periodic` axis the face
-/// on the min side is the seam between cell n−1 (lo) and cell 0 (hi), and is visited too (its
-/// copy on the max side is not); not where n = 1 (the cell would neighbour itself).
-template <class Visit>
+/// Calls visit(face, lo cell, hi cell) (flat indices: the face's in its face array, the cells'
+/// in the cell arrays) for every face of component `axis` that lies strictly inside the box; the
+/// hi cell is the one at the face's own (i, j, k). With a `periodic` axis the face on the min side
+/// is the seam between cell n−1 (lo) and cell 0 (hi), and is visited too (its copy on the max
+/// side is not); not where n = 1 (the cell would neighbour itself). Row by row in (k, j, i) order;
+/// with `Parallel` the k-planes are split over threads (only for visits that write nothing another
+/// face's visit reads or writes).
+template <bool Parallel, class Visit>
 void for_each_interior_face(const MacGrid& grid, int axis, bool periodic, Visit&& visit) {
-    const Array3<double>& faces = grid.velocity(axis);
-    const int n_axis = grid.cells(axis);
-    const bool seam = periodic && n_axis > 1;
-    for (int k = 0; k < faces.nk(); ++k) {
-        for (int j = 0; j < faces.nj(); ++j) {
-            for (int i = 0; i < faces.ni(); ++i) {
-                const int along = axis == 0 ? i : (axis == 1 ? j : k);
-                if ((along == 0 && !seam) || along == n_axis) {
-                    continue;
-                }
-                const int back = along == 0 ? n_axis - 1 : -1;  // to the lo cell
-                visit(i, j, k, i + (axis == 0 ? back : 0), j + (axis == 1 ? back : 0),
-                      k + (axis == 2 ? back : 0));
-            }
-        }
-    }
-}
-
-/// for_each_interior_face() by rows with flat indices, the rows of each k in parallel:
-/// visit(face index in the face array, lo cell, hi cell), the cells' flat indices. Only for
-/// visits that write nothing another face's visit reads or writes.
-template <class Visit>
-void parallel_for_each_interior_face(const MacGrid& grid, int axis, bool periodic, Visit&& visit) {
     const Array3<double>& faces = grid.velocity(axis);
     const int n_axis = grid.cells(axis);
     const bool seam = periodic && n_axis > 1;
@@ -157,25 +137,29 @@ void parallel_for_each_interior_face(const MacGrid& grid, int axis, bool periodi
     const std::size_t cell_step = axis == 0 ? 1 : (axis == 1 ? nx : nx * ny);
     // The seam's lo cell is the last one along the axis.
     const std::size_t seam_step = static_cast<std::size_t>(n_axis - 1) * cell_step;
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, faces.nk()), [&](const tbb::blocked_range<int>& r) {
-            for (int k = r.begin(); k != r.end(); ++k)
-                for (int j = 0; j < faces.nj(); ++j) {
-                    const int row_along = axis == 1 ? j : k;
-                    if (axis != 0 && ((row_along == 0 && !seam) || row_along == n_axis))
+    const auto planes = [&](const tbb::blocked_range<int>& r) {
+        for (int k = r.begin(); k != r.end(); ++k)
+            for (int j = 0; j < faces.nj(); ++j) {
+                const int row_along = axis == 1 ? j : k;
+                if (axis != 0 && ((row_along == 0 && !seam) || row_along == n_axis))
+                    continue;
+                const std::size_t face_row = faces.index(0, j, k);
+                const std::size_t cell_row = nx * (static_cast<std::size_t>(j) + ny * k);
+                for (int i = 0; i < faces.ni(); ++i) {
+                    const int along = axis == 0 ? i : row_along;
+                    if ((along == 0 && !seam) || along == n_axis)
                         continue;
-                    const std::size_t face_row = faces.index(0, j, k);
-                    const std::size_t cell_row = nx * (static_cast<std::size_t>(j) + ny * k);
-                    for (int i = 0; i < faces.ni(); ++i) {
-                        const int along = axis == 0 ? i : row_along;
-                        if ((along == 0 && !seam) || along == n_axis)
-                            continue;
-                        const std::size_t hi = cell_row + static_cast<std::size_t>(i);
-                        visit(face_row + static_cast<std::size_t>(i),
-                              along == 0 ? hi + seam_step : hi - cell_step, hi);
-                    }
+                    const std::size_t hi = cell_row + static_cast<std::size_t>(i);
+                    visit(face_row + static_cast<std::size_t>(i),
+                          along == 0 ? hi + seam_step : hi - cell_step, hi);
                 }
-        });
+            }
+    };
+    const tbb::blocked_range<int> all(0, faces.nk());
+    if constexpr (Parallel)
+        tbb::parallel_for(all, planes);
+    else
+        planes(all);
 }
 
 /// Calls visit(axis, face index (i, j, k), the cell inside it, its coupling) for every boundary
@@ -271,34 +255,33 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
         a.periodic[static_cast<std::size_t>(axis)] = boundaries.periodic(axis);
         Array3<double>& off = a.off(axis);
         const Array3<double>& kappa = interface.kappa(axis);
-        for_each_interior_face(grid, axis, boundaries.periodic(axis),
-                               [&](int i, int j, int k, int li, int lj, int lk) {
-                                   const std::size_t hi = phi.index(i, j, k);
-                                   const std::size_t lo = phi.index(li, lj, lk);
-                                   const FaceCoupling face =
-                                       classify(phi[lo], phi[hi], kappa(i, j, k));
-                                   switch (face.kind) {
-                                       case FaceCoupling::Kind::none:
-                                           break;
-                                       case FaceCoupling::Kind::coupled:
-                                           a.diag[lo] += face.beta;
-                                           a.diag[hi] += face.beta;
-                                           off[lo] = -face.beta;
-                                           b[lo] -= face.beta * face.jump;
-                                           b[hi] += face.beta * face.jump;
-                                           break;
-                                       case FaceCoupling::Kind::dirichlet_lo:
-                                           a.diag[lo] += face.beta;
-                                           b[lo] += face.beta * face.boundary_pressure;
-                                           has_dirichlet = true;
-                                           break;
-                                       case FaceCoupling::Kind::dirichlet_hi:
-                                           a.diag[hi] += face.beta;
-                                           b[hi] += face.beta * face.boundary_pressure;
-                                           has_dirichlet = true;
-                                           break;
-                                   }
-                               });
+        // In order (the sums into a cell's diagonal and right-hand side as before).
+        for_each_interior_face<false>(grid, axis, boundaries.periodic(axis),
+                                      [&](std::size_t f, std::size_t lo, std::size_t hi) {
+                                          const FaceCoupling face =
+                                              classify(phi[lo], phi[hi], kappa[f]);
+                                          switch (face.kind) {
+                                              case FaceCoupling::Kind::none:
+                                                  break;
+                                              case FaceCoupling::Kind::coupled:
+                                                  a.diag[lo] += face.beta;
+                                                  a.diag[hi] += face.beta;
+                                                  off[lo] = -face.beta;
+                                                  b[lo] -= face.beta * face.jump;
+                                                  b[hi] += face.beta * face.jump;
+                                                  break;
+                                              case FaceCoupling::Kind::dirichlet_lo:
+                                                  a.diag[lo] += face.beta;
+                                                  b[lo] += face.beta * face.boundary_pressure;
+                                                  has_dirichlet = true;
+                                                  break;
+                                              case FaceCoupling::Kind::dirichlet_hi:
+                                                  a.diag[hi] += face.beta;
+                                                  b[hi] += face.beta * face.boundary_pressure;
+                                                  has_dirichlet = true;
+                                                  break;
+                                          }
+                                      });
     }
     for_each_outflow_face(grid, interface, phases, mode, boundaries,
                           [&](int, int, int, int, std::size_t c, const FaceCoupling& face) {
@@ -441,7 +424,7 @@ void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
             throw std::invalid_argument(
                 "apply_pressure_gradient: InterfaceInput.kappa_" + std::string(1, "uvw"[axis]) +
                 " must have the face counts of the grid's velocity component");
-        parallel_for_each_interior_face(
+        for_each_interior_face<true>(
             grid, axis, boundaries.periodic(axis),
             [&](std::size_t f, std::size_t lo, std::size_t hi) {
                 const FaceCoupling face = classify(phi[lo], phi[hi], kappa[f]);
