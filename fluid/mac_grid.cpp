@@ -171,15 +171,6 @@ Eigen::Vector3d MacGrid::sample_velocity(const Eigen::Vector3d& x) const {
             interpolate_trilinear(m_velocity[2], FieldLocation::z_face, g, m_periodic)};
 }
 
-double MacGrid::divergence(int i, int j, int k) const {
-    const Array3<double>& u_face = m_velocity[0];
-    const Array3<double>& v_face = m_velocity[1];
-    const Array3<double>& w_face = m_velocity[2];
-    return (u_face(i + 1, j, k) - u_face(i, j, k) + v_face(i, j + 1, k) - v_face(i, j, k) +
-            w_face(i, j, k + 1) - w_face(i, j, k)) /
-           m_dx;
-}
-
 Eigen::Vector3d MacGrid::max_abs_velocity() const {
     Eigen::Vector3d result = Eigen::Vector3d::Zero();
     for (int axis = 0; axis < 3; ++axis) {

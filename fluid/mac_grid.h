@@ -112,8 +112,23 @@ public:
     /// Velocity (m/s) at position `x` (m), each component interpolated on its own faces.
     Eigen::Vector3d sample_velocity(const Eigen::Vector3d& x) const;
 
-    /// Discrete divergence of cell (i, j, k): Σ outward face velocity / dx, in 1/s.
-    double divergence(int i, int j, int k) const;
+    /// Discrete divergence of cell (i, j, k): Σ outward face velocity / dx, in 1/s. Inline, by
+    /// flat index with one bounds check: the projection's loops call it for every cell.
+    double divergence(int i, int j, int k) const {
+        MENISCUS_ASSERT(i >= 0 && j >= 0 && k >= 0 && i < m_nx && j < m_ny && k < m_nz,
+                        "MacGrid::divergence: cell out of range");
+        const Array3<double>& u_face = m_velocity[0];
+        const Array3<double>& v_face = m_velocity[1];
+        const Array3<double>& w_face = m_velocity[2];
+        const std::size_t u = u_face.index(i, j, k);
+        const std::size_t v = v_face.index(i, j, k);
+        const std::size_t w = w_face.index(i, j, k);
+        const std::size_t v_step = static_cast<std::size_t>(v_face.ni());
+        const std::size_t w_step = static_cast<std::size_t>(w_face.ni()) * w_face.nj();
+        return (u_face[u + 1] - u_face[u] + v_face[v + v_step] - v_face[v] + w_face[w + w_step] -
+                w_face[w]) /
+               m_dx;
+    }
     /// Largest |u|, |v|, |w| over all faces, per component (m/s).
     Eigen::Vector3d max_abs_velocity() const;
     /// Sets the velocity on every wall face (normal component on the box boundary) to zero.

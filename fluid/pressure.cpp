@@ -91,35 +91,6 @@ private:
     FaceCoupling m_liquid, m_gas;
 };
 
-/// MacGrid::divergence() of cell c = (i, j, k) (flat index) from the face arrays' storage, with
-/// the same operations in the same order, without its bounds checks.
-class FlatDivergence {
-public:
-    explicit FlatDivergence(const MacGrid& grid)
-        : m_u(grid.u().data()),
-          m_v(grid.v().data()),
-          m_w(grid.w().data()),
-          m_nx(static_cast<std::size_t>(grid.nx())),
-          m_ny(static_cast<std::size_t>(grid.ny())),
-          m_dx(grid.dx()) {}
-
-    double operator()(std::size_t c, int j, int k) const {
-        const std::size_t row = static_cast<std::size_t>(j) + m_ny * static_cast<std::size_t>(k);
-        const std::size_t i = c - m_nx * row;
-        const std::size_t u = i + (m_nx + 1) * row;             // u(i, j, k)
-        const std::size_t v = i + m_nx * (j + (m_ny + 1) * k);  // v(i, j, k)
-        return (m_u[u + 1] - m_u[u] + m_v[v + m_nx] - m_v[v] + m_w[c + m_nx * m_ny] - m_w[c]) /
-               m_dx;
-    }
-
-private:
-    const double* m_u;
-    const double* m_v;
-    const double* m_w;
-    std::size_t m_nx, m_ny;
-    double m_dx;
-};
-
 /// Calls visit(face, lo cell, hi cell) (flat indices: the face's in its face array, the cells'
 /// in the cell arrays) for every face of component `axis` that lies strictly inside the box; the
 /// hi cell is the one at the face's own (i, j, k). With a `periodic` axis the face on the min side
@@ -290,7 +261,6 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
                               has_dirichlet = true;
                           });
     const double flux_scale = grid.dx() * grid.dx() / dt;
-    const FlatDivergence divergence(grid);
     for (int k = 0; k < nz; ++k) {
         for (int j = 0; j < ny; ++j) {
             for (int i = 0; i < nx; ++i) {
@@ -298,7 +268,7 @@ PressureSystem build_pressure_system(const MacGrid& grid, const InterfaceInput& 
                 if (!is_unknown(phi[c], mode)) {
                     continue;
                 }
-                b[c] -= flux_scale * divergence(c, j, k);
+                b[c] -= flux_scale * grid.divergence(i, j, k);
                 if (a.diag[c] <= 0.0) {
                     // An unknown cell with no open face (a 1-cell box): nothing to solve.
                     b[c] = 0.0;
@@ -462,7 +432,6 @@ double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface
     const Array3<double>& phi = interface.phi;
     if (phi.ni() != grid.nx() || phi.nj() != grid.ny() || phi.nk() != grid.nz())
         throw std::invalid_argument("max_fluid_divergence: phi must have the grid's cell counts");
-    const FlatDivergence divergence(grid);
     // A largest value: the same whatever the split.
     return tbb::parallel_reduce(
         tbb::blocked_range<int>(0, grid.nz()), 0.0,
@@ -470,9 +439,9 @@ double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface
             for (int k = r.begin(); k != r.end(); ++k)
                 for (int j = 0; j < grid.ny(); ++j) {
                     const std::size_t row = phi.index(0, j, k);
-                    for (std::size_t c = row; c != row + static_cast<std::size_t>(grid.nx()); ++c)
-                        if (is_unknown(phi[c], mode))
-                            largest = std::max(largest, std::abs(divergence(c, j, k)));
+                    for (int i = 0; i < grid.nx(); ++i)
+                        if (is_unknown(phi[row + static_cast<std::size_t>(i)], mode))
+                            largest = std::max(largest, std::abs(grid.divergence(i, j, k)));
                 }
             return largest;
         },
