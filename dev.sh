@@ -4,7 +4,10 @@
 #   ./dev.sh test                                       runs the whole test suite through ctest
 #   ./dev.sh sanitize                                   builds in build-sanitize/ with Address- and
 #                                                       UndefinedBehaviorSanitizer and runs the fast
-#                                                       tests there (CI runs it after `test`)
+#                                                       tests there (CI runs it after `test`); the
+#                                                       libraries and the program are instrumented,
+#                                                       the test programs' own files have ASan only
+#                                                       (tests/CMakeLists.txt)
 #   ./dev.sh build                                      only sets up and builds
 # Idempotent: with everything installed and built it only checks and runs.
 set -euo pipefail
