@@ -34,12 +34,16 @@ Array3<double>& InterfaceInput::kappa(int axis) {
     return axis == 0 ? kappa_u : (axis == 1 ? kappa_v : kappa_w);
 }
 
-void InterfaceInput::validate(const MacGrid& grid) const {
+void InterfaceInput::check_sizes(const MacGrid& grid) const {
     const int nx = grid.nx(), ny = grid.ny(), nz = grid.nz();
     check_size(phi, nx, ny, nz, "phi");
     check_size(kappa_u, nx + 1, ny, nz, "kappa_u");
     check_size(kappa_v, nx, ny + 1, nz, "kappa_v");
     check_size(kappa_w, nx, ny, nz + 1, "kappa_w");
+}
+
+void InterfaceInput::validate(const MacGrid& grid) const {
+    check_sizes(grid);
     for (double value : phi.storage()) {
         if (!std::isfinite(value)) {
             throw std::invalid_argument("InterfaceInput.phi holds a non-finite value");

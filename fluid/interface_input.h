@@ -40,6 +40,9 @@ struct InterfaceInput {
     /// Throws std::invalid_argument naming the field if an array is not sized for `grid` or φ
     /// holds a non-finite value.
     void validate(const MacGrid& grid) const;
+    /// validate()'s size checks alone (no pass over φ), for the grid loops that index the arrays
+    /// by the grid's flat indices.
+    void check_sizes(const MacGrid& grid) const;
 };
 
 /// True when a cell with level set value `phi` is liquid (φ < 0).

@@ -378,22 +378,15 @@ void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
                              const PressureOptions& options, const Array3<double>& pressure,
                              const BoundaryOptions& boundaries) {
     const Array3<double>& phi = interface.phi;
-    const auto same_size = [](const Array3<double>& a, int ni, int nj, int nk) {
-        return a.ni() == ni && a.nj() == nj && a.nk() == nk;
-    };
-    if (!same_size(phi, grid.nx(), grid.ny(), grid.nz()) ||
-        !same_size(pressure, grid.nx(), grid.ny(), grid.nz()))
+    interface.check_sizes(grid);
+    if (pressure.ni() != grid.nx() || pressure.nj() != grid.ny() || pressure.nk() != grid.nz())
         throw std::invalid_argument(
-            "apply_pressure_gradient: phi and pressure must have the grid's cell counts");
+            "apply_pressure_gradient: pressure must have the grid's cell counts");
     const double scale = dt / grid.dx();
     const FaceClassifier classify(phases, mode, options.min_liquid_fraction);
     for (int axis = 0; axis < 3; ++axis) {
         Array3<double>& velocity = grid.velocity(axis);
         const Array3<double>& kappa = interface.kappa(axis);
-        if (!same_size(kappa, velocity.ni(), velocity.nj(), velocity.nk()))
-            throw std::invalid_argument(
-                "apply_pressure_gradient: InterfaceInput.kappa_" + std::string(1, "uvw"[axis]) +
-                " must have the face counts of the grid's velocity component");
         for_each_interior_face<true>(
             grid, axis, boundaries.periodic(axis),
             [&](std::size_t f, std::size_t lo, std::size_t hi) {
@@ -430,8 +423,7 @@ void apply_pressure_gradient(MacGrid& grid, const InterfaceInput& interface,
 
 double max_fluid_divergence(const MacGrid& grid, const InterfaceInput& interface, FluidMode mode) {
     const Array3<double>& phi = interface.phi;
-    if (phi.ni() != grid.nx() || phi.nj() != grid.ny() || phi.nk() != grid.nz())
-        throw std::invalid_argument("max_fluid_divergence: phi must have the grid's cell counts");
+    interface.check_sizes(grid);
     // A largest value: the same whatever the split.
     return tbb::parallel_reduce(
         tbb::blocked_range<int>(0, grid.nz()), 0.0,
