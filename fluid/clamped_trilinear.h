@@ -11,6 +11,16 @@
 
 namespace meniscus::fluid {
 
+/// A coordinate `t` (cells from sample 0) on a lattice axis whose last sample is `last`: clamped
+/// onto [0, last], the lower sample of the pair around it (at most `lower_max`, last − 1 or 0 on
+/// a one-sample axis) and the fraction from it. Branch-free (a vectorisable select).
+inline void split_coordinate(double t, double last, int lower_max, int& lower, double& fraction) {
+    const double s = std::min(std::max(t, 0.0), last);
+    const int truncated = static_cast<int>(s);  // s ≥ 0: truncation floors
+    lower = truncated < lower_max ? truncated : lower_max;
+    fraction = s - lower;
+}
+
 /// Samples a field whose sample (0, 0, 0) sits at `offset` (cell units, field_offset()), at
 /// points in cell units relative to the grid origin. Points off the lattice are clamped onto it
 /// (constant extrapolation); no axis is periodic. Holds a pointer to the field's storage: the
@@ -20,10 +30,10 @@ public:
     ClampedTrilinear(const Array3<double>& field, const Eigen::Vector3d& offset)
         : m_data(field.data()),
           m_axes{
-              Axis{field.ni(), offset.x(), 1},
-              Axis{field.nj(), offset.y(), static_cast<std::size_t>(field.ni())},
-              Axis{field.nk(), offset.z(),
-                   static_cast<std::size_t>(field.ni()) * static_cast<std::size_t>(field.nj())}} {}
+              Axis(field.ni(), offset.x(), 1),
+              Axis(field.nj(), offset.y(), static_cast<std::size_t>(field.ni())),
+              Axis(field.nk(), offset.z(),
+                   static_cast<std::size_t>(field.ni()) * static_cast<std::size_t>(field.nj()))} {}
 
     /// The interpolated value at `g` (cell units).
     double value(const Eigen::Vector3d& g) const {
@@ -40,8 +50,12 @@ public:
         gather(g, c, fx, fy, fz);
         TrilinearSample s;
         s.value = blend(c, fx, fy, fz);
-        s.min = *std::min_element(c, c + 8);
-        s.max = *std::max_element(c, c + 8);
+        // Pairwise, each taking the earlier of equal samples: std::min_element's and
+        // std::max_element's choices, in fewer dependent steps.
+        const auto lo = [](double a, double b) { return std::min(a, b); };
+        const auto hi = [](double a, double b) { return std::max(a, b); };
+        s.min = lo(lo(lo(c[0], c[1]), lo(c[2], c[3])), lo(lo(c[4], c[5]), lo(c[6], c[7])));
+        s.max = hi(hi(hi(c[0], c[1]), hi(c[2], c[3])), hi(hi(c[4], c[5]), hi(c[6], c[7])));
         return s;
     }
 
@@ -58,29 +72,31 @@ public:
     }
 
 private:
-    /// One lattice axis: sample count, offset of sample 0 (cells) and flat-index stride.
+    /// One lattice axis: the offset of sample 0 (cells), the last sample's index and the largest
+    /// lower index of a pair (both 0 on a one-sample axis), the flat-index stride and the step
+    /// from the lower sample to the upper one (0 on a one-sample axis).
     struct Axis {
-        int n;
+        Axis(int n, double offset_, std::size_t stride_)
+            : offset(offset_),
+              last(n > 1 ? n - 1 : 0),
+              lower_max(n > 1 ? n - 2 : 0),
+              stride(stride_),
+              step(n > 1 ? stride_ : 0) {}
         double offset;
+        double last;
+        int lower_max;
         std::size_t stride;
+        std::size_t step;
     };
 
-    /// The lower sample's flat-index part, the step to the upper one (0 on a one-sample axis)
-    /// and the fraction between them, for coordinate `g` (cells) along `axis`: clamped onto
-    /// [0, n−1], the lower index at most n−2.
+    /// The lower sample's flat-index part, the step to the upper one and the fraction between
+    /// them, for coordinate `g` (cells) along `axis`.
     static void split(const Axis& axis, double g, std::size_t& base, std::size_t& step,
                       double& fraction) {
-        if (axis.n <= 1) {
-            base = 0;
-            step = 0;
-            fraction = 0.0;
-            return;
-        }
-        const double s = std::clamp(g - axis.offset, 0.0, static_cast<double>(axis.n - 1));
-        const int lower = std::min(static_cast<int>(s), axis.n - 2);  // s ≥ 0: truncation floors
-        fraction = s - lower;
+        int lower;
+        split_coordinate(g - axis.offset, axis.last, axis.lower_max, lower, fraction);
         base = static_cast<std::size_t>(lower) * axis.stride;
-        step = axis.stride;
+        step = axis.step;
     }
 
     void gather(const Eigen::Vector3d& g, double* c, double& fx, double& fy, double& fz) const {
@@ -101,6 +117,84 @@ private:
 
     const double* m_data;
     Axis m_axes[3];
+};
+
+/// The three face velocities of a MAC grid (u, v, w of mac_grid.h) sampled at one point, each
+/// as ClampedTrilinear samples it (bit for bit). Along each axis the component normal to it has
+/// its samples on the faces (offset 0, n + 1 samples) and the other two at the cell centres
+/// (offset ½, n samples), so those two share their lower sample and fraction: 6 splits of a
+/// coordinate instead of 9. Holds pointers to the arrays' storage (see ClampedTrilinear).
+class ClampedVelocity {
+public:
+    ClampedVelocity(const Array3<double>& u, const Array3<double>& v, const Array3<double>& w)
+        : m_components{Component(u), Component(v), Component(w)} {
+        const int cells[3] = {v.ni(), u.nj(), u.nk()};
+        for (int a = 0; a < 3; ++a) {
+            m_face[a] = Lattice(cells[a] + 1, 0.0);
+            m_centre[a] = Lattice(cells[a], 0.5);
+        }
+        for (int c = 0; c < 3; ++c)
+            for (int a = 0; a < 3; ++a) {
+                const Lattice& l = a == c ? m_face[a] : m_centre[a];
+                Component& m = m_components[c];
+                m.step[a] = l.last > 0.0 ? m.stride[a] : 0;
+            }
+    }
+
+    /// u, v and w (m/s) at `g` (cell units).
+    Eigen::Vector3d value(const Eigen::Vector3d& g) const {
+        int face_lower[3], centre_lower[3];
+        double face_fraction[3], centre_fraction[3];
+        for (int a = 0; a < 3; ++a) {
+            m_face[a].split(g[a], face_lower[a], face_fraction[a]);
+            m_centre[a].split(g[a], centre_lower[a], centre_fraction[a]);
+        }
+        return Eigen::Vector3d(
+            m_components[0].value(face_lower[0], centre_lower[1], centre_lower[2], face_fraction[0],
+                                  centre_fraction[1], centre_fraction[2]),
+            m_components[1].value(centre_lower[0], face_lower[1], centre_lower[2],
+                                  centre_fraction[0], face_fraction[1], centre_fraction[2]),
+            m_components[2].value(centre_lower[0], centre_lower[1], face_lower[2],
+                                  centre_fraction[0], centre_fraction[1], face_fraction[2]));
+    }
+
+private:
+    /// One lattice along one axis: offset of sample 0 (cells), the last sample's index and the
+    /// largest lower index (split_coordinate()).
+    struct Lattice {
+        Lattice() = default;
+        Lattice(int n, double offset_)
+            : offset(offset_), last(n > 1 ? n - 1 : 0), lower_max(n > 1 ? n - 2 : 0) {}
+        void split(double g, int& lower, double& fraction) const {
+            split_coordinate(g - offset, last, lower_max, lower, fraction);
+        }
+        double offset = 0.0;
+        double last = 0.0;
+        int lower_max = 0;
+    };
+
+    /// One component's storage, strides and steps to the upper samples.
+    struct Component {
+        explicit Component(const Array3<double>& f)
+            : data(f.data()),
+              stride{1, static_cast<std::size_t>(f.ni()),
+                     static_cast<std::size_t>(f.ni()) * static_cast<std::size_t>(f.nj())} {}
+        double value(int i, int j, int k, double fx, double fy, double fz) const {
+            const double* p = data + static_cast<std::size_t>(i) +
+                              static_cast<std::size_t>(j) * stride[1] +
+                              static_cast<std::size_t>(k) * stride[2];
+            const std::size_t dx = step[0], dy = step[1], dz = step[2];
+            const double c[8] = {p[0],  p[dx],      p[dy],      p[dy + dx],
+                                 p[dz], p[dz + dx], p[dz + dy], p[dz + dy + dx]};
+            return ClampedTrilinear::blend(c, fx, fy, fz);
+        }
+        const double* data;
+        std::size_t stride[3];
+        std::size_t step[3] = {0, 0, 0};
+    };
+
+    Component m_components[3];
+    Lattice m_face[3], m_centre[3];
 };
 
 }  // namespace meniscus::fluid

@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <stdexcept>
 
 #include "fluid/advection.h"
+#include "fluid/clamped_trilinear.h"
 
 namespace meniscus::fluid {
 namespace {
@@ -17,6 +19,64 @@ constexpr AdvectionScheme ALL_SCHEMES[] = {AdvectionScheme::semi_lagrangian, Adv
 void set_uniform_velocity(MacGrid& grid, const Eigen::Vector3d& velocity) {
     for (int axis = 0; axis < 3; ++axis) {
         grid.velocity(axis).fill(velocity[axis]);
+    }
+}
+
+/// Trilinear interpolation written out plainly (clamp, floor, the lower index at most n − 2, the
+/// same order of blends as ClampedTrilinear::blend): the reference of the samplers' bit-for-bit
+/// results. Also the smallest and largest of the 8 samples.
+TrilinearSample reference_trilinear(const Array3<double>& field, const Eigen::Vector3d& offset,
+                                    const Eigen::Vector3d& g) {
+    const int n[3] = {field.ni(), field.nj(), field.nk()};
+    int lo[3], up[3];
+    double t[3];
+    for (int a = 0; a < 3; ++a) {
+        if (n[a] == 1) {
+            lo[a] = up[a] = 0;
+            t[a] = 0.0;
+            continue;
+        }
+        const double s = std::clamp(g[a] - offset[a], 0.0, n[a] - 1.0);
+        lo[a] = std::min(static_cast<int>(std::floor(s)), n[a] - 2);
+        up[a] = lo[a] + 1;
+        t[a] = s - lo[a];
+    }
+    double c[8];
+    for (int corner = 0; corner < 8; ++corner)
+        c[corner] = field((corner & 1) ? up[0] : lo[0], (corner & 2) ? up[1] : lo[1],
+                          (corner & 4) ? up[2] : lo[2]);
+    const auto lerp = [](double a, double b, double f) { return a + f * (b - a); };
+    const double c0 = lerp(lerp(c[0], c[1], t[0]), lerp(c[2], c[3], t[0]), t[1]);
+    const double c1 = lerp(lerp(c[4], c[5], t[0]), lerp(c[6], c[7], t[0]), t[1]);
+    return {lerp(c0, c1, t[2]), *std::min_element(c, c + 8), *std::max_element(c, c + 8)};
+}
+
+TEST(FluidAdvection, ClampedSamplersMatchAPlainTrilinearInterpolationBitForBit) {
+    // One cell thick along y: u and w have a single sample along it there. Points up to two
+    // cells outside the box on every side (clamped), and repeated sample values (ties in the
+    // bounds).
+    MacGrid grid(5, 1, 4, 0.1);
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> value(-1.0, 1.0);
+    for (int axis = 0; axis < 3; ++axis)
+        for (double& v : grid.velocity(axis).storage())
+            v = std::round(4.0 * value(random)) / 4.0;
+    const ClampedVelocity velocity(grid.u(), grid.v(), grid.w());
+    std::uniform_real_distribution<double> x(-2.0, 7.0), y(-2.0, 3.0), z(-2.0, 6.0);
+    for (int point = 0; point < 2000; ++point) {
+        const Eigen::Vector3d g(x(random), y(random), z(random));
+        const Eigen::Vector3d sampled = velocity.value(g);
+        for (int axis = 0; axis < 3; ++axis) {
+            const FieldLocation location = face_location(axis);
+            const Array3<double>& faces = grid.velocity(axis);
+            const TrilinearSample expected = reference_trilinear(faces, field_offset(location), g);
+            const TrilinearSample one = ClampedTrilinear(faces, field_offset(location)).sample(g);
+            ASSERT_EQ(sampled[axis], expected.value) << "axis " << axis << " at " << g.transpose();
+            ASSERT_EQ(one.value, expected.value);
+            ASSERT_EQ(one.min, expected.min);
+            ASSERT_EQ(one.max, expected.max);
+            ASSERT_EQ(interpolate_trilinear(faces, location, g), expected.value);
+        }
     }
 }
 
