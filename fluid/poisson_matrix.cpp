@@ -233,6 +233,35 @@ ResidualDots jacobi_cg_update(double alpha, const std::vector<double>& p,
         });
 }
 
+ResidualDots jacobi_cg_start(const std::vector<double>& b, const std::vector<double>& q,
+                             const std::vector<double>& d, std::vector<double>& r,
+                             std::vector<double>& z, std::vector<double>& p) {
+    r.resize(b.size());
+    z.resize(b.size());
+    p.resize(b.size());
+    const double* bv = b.data();
+    const double* qv = q.data();
+    const double* dv = d.data();
+    double* rv = r.data();
+    double* zv = z.data();
+    double* pv = p.data();
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, b.size(), VECTOR_GRAIN), ResidualDots{},
+        [&](const tbb::blocked_range<std::size_t>& range, ResidualDots sums) {
+            for (std::size_t c = range.begin(); c != range.end(); ++c) {
+                rv[c] = bv[c] - qv[c];
+                zv[c] = rv[c] / dv[c];
+                pv[c] = zv[c];
+                sums.rr += rv[c] * rv[c];
+                sums.rz += rv[c] * zv[c];
+            }
+            return sums;
+        },
+        [](const ResidualDots& a, const ResidualDots& c) {
+            return ResidualDots{a.rr + c.rr, a.rz + c.rz};
+        });
+}
+
 void axpy(double alpha, const std::vector<double>& x, std::vector<double>& y) {
     const double* xv = x.data();
     double* yv = y.data();

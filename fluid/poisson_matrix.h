@@ -79,6 +79,11 @@ ResidualDots jacobi_cg_update(double alpha, const std::vector<double>& p,
                               const std::vector<double>& q, const std::vector<double>& d,
                               std::vector<double>& x, std::vector<double>& r,
                               std::vector<double>& z);
+/// The start of a Jacobi-preconditioned CG in a single pass: r = b − q (q = A x₀), z = r / d,
+/// p = z, returning r·r and r·z (summed in dot()'s order). Resizes r, z and p to b's size.
+ResidualDots jacobi_cg_start(const std::vector<double>& b, const std::vector<double>& q,
+                             const std::vector<double>& d, std::vector<double>& r,
+                             std::vector<double>& z, std::vector<double>& p);
 /// Subtracts the mean over active cells of `matrix` from x on those cells (projection onto the
 /// complement of the constant null space of a pure-Neumann operator).
 void remove_active_mean(const PoissonMatrix& matrix, std::vector<double>& x);

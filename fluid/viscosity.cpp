@@ -2,6 +2,9 @@
 
 #include "fluid/surface_viscosity.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -23,6 +26,9 @@ namespace meniscus::fluid {
 /// faces one layer out, no further. What the CG refreshes every iteration (a depth of 0, no
 /// exchange, fails the distributed tests by 3e5 times their tolerance; 1 passes them).
 constexpr int VISCOUS_HALO_DEPTH = 1;
+
+/// Faces per task of the solve's set-up pass.
+constexpr std::size_t SETUP_GRAIN = 16384;
 
 void ViscosityOptions::validate() const {
     iteration.validate();
@@ -273,20 +279,28 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     std::vector<double>& b = ws.b;
     // Split u* into the unknowns x (initial guess) and the fixed faces; b = ρ u* − K u_fixed,
     // K's wall strains relative to moving walls.
+    // In one pass with the split: whether the fixed faces are at rest, and ρ u* on the unknowns
+    // (b when they are).
     op.gather(grid, ws.u_star);
-    x.assign(n, 0.0);
-    fixed.assign(n, 0.0);
-    bool fixed_at_rest = true;
-    for (std::size_t f = 0; f < n; ++f) {
-        (unknown[f] ? x[f] : fixed[f]) = ws.u_star[f];
-        fixed_at_rest = fixed_at_rest && fixed[f] == 0.0;
-    }
+    x.resize(n);
+    fixed.resize(n);
+    b.resize(n);
+    const bool fixed_at_rest = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, n, SETUP_GRAIN), true,
+        [&](const tbb::blocked_range<std::size_t>& range, bool at_rest) {
+            for (std::size_t f = range.begin(); f != range.end(); ++f) {
+                const double u = ws.u_star[f];
+                x[f] = unknown[f] ? u : 0.0;
+                fixed[f] = unknown[f] ? 0.0 : u;
+                b[f] = unknown[f] ? density[f] * u : 0.0;
+                at_rest = at_rest && fixed[f] == 0.0;
+            }
+            return at_rest;
+        },
+        [](bool a, bool c) { return a && c; });
     if (fixed_at_rest && !walls.moving()) {
         // K 0 = 0 (the map is linear without moving walls): b = ρ u* exactly, without the
         // operator's three passes (two_phase in a box of walls at rest: every step).
-        b.resize(n);
-        for (std::size_t f = 0; f < n; ++f)
-            b[f] = unknown[f] ? density[f] * ws.u_star[f] : 0.0;
     } else {
         op.stiffness(fixed, b, walls.moving() ? &walls : nullptr);
         for (std::size_t f = 0; f < n; ++f) {
@@ -349,15 +363,22 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
         };
         // On one process the plain diagonal's update, residual and dot products take one pass.
         const bool fused_jacobi = !distributed && diagonal_kind && !surface_jacobi;
-        r.resize(n);
-        z.resize(n);
         op.apply(x, q);
-        for (std::size_t f = 0; f < n; ++f)
-            r[f] = b[f] - q[f];
-        precondition();
-        p = z;
-        double rz = global_dot(r, z);
-        result.residual = std::sqrt(global_dot(r, r)) / b_norm;
+        double rz = 0.0;
+        if (fused_jacobi) {
+            const ResidualDots dots = jacobi_cg_start(b, q, diagonal, r, z, p);
+            rz = dots.rz;
+            result.residual = std::sqrt(dots.rr) / b_norm;
+        } else {
+            r.resize(n);
+            z.resize(n);
+            for (std::size_t f = 0; f < n; ++f)
+                r[f] = b[f] - q[f];
+            precondition();
+            p = z;
+            rz = global_dot(r, z);
+            result.residual = std::sqrt(global_dot(r, r)) / b_norm;
+        }
         result.converged = result.residual <= options.iteration.tolerance;
         while (!result.converged && result.iterations < options.iteration.max_iterations) {
             options.iteration.cancel.throw_if_requested("the viscosity solve");
