@@ -550,6 +550,48 @@ TEST(FluidPressureBackends, FusedPcgFollowsTheTextbookIterates) {
     }
 }
 
+TEST(FluidPressureBackends, FusedJacobiCgPassesGiveTheSeparateOperationsBitForBit) {
+    // Several of the reductions' chunks and a ragged last one.
+    const std::size_t n = 70001;
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> value(-1.0, 1.0), positive(0.5, 4.0);
+    std::vector<double> b(n), q(n), d(n), p0(n), x0(n);
+    for (std::size_t c = 0; c < n; ++c) {
+        b[c] = value(random);
+        q[c] = value(random);
+        d[c] = positive(random);
+        p0[c] = value(random);
+        x0[c] = value(random);
+    }
+    // The start: r = b − q, z = r / d, p = z, r·r and r·z.
+    std::vector<double> r(n), z(n);
+    for (std::size_t c = 0; c < n; ++c) {
+        r[c] = b[c] - q[c];
+        z[c] = r[c] / d[c];
+    }
+    std::vector<double> fused_r, fused_z, fused_p;
+    const ResidualDots start = jacobi_cg_start(b, q, d, fused_r, fused_z, fused_p);
+    EXPECT_EQ(fused_r, r);
+    EXPECT_EQ(fused_z, z);
+    EXPECT_EQ(fused_p, z);
+    EXPECT_EQ(start.rr, dot(r, r));
+    EXPECT_EQ(start.rz, dot(r, z));
+    // An update: x += αp, r −= αq, z = r / d, r·r and r·z.
+    const double alpha = 0.37;
+    std::vector<double> x = x0;
+    axpy(alpha, p0, x);
+    axpy(-alpha, q, r);
+    for (std::size_t c = 0; c < n; ++c)
+        z[c] = r[c] / d[c];
+    std::vector<double> fused_x = x0;
+    const ResidualDots update = jacobi_cg_update(alpha, p0, q, d, fused_x, fused_r, fused_z);
+    EXPECT_EQ(fused_x, x);
+    EXPECT_EQ(fused_r, r);
+    EXPECT_EQ(fused_z, z);
+    EXPECT_EQ(update.rr, dot(r, r));
+    EXPECT_EQ(update.rz, dot(r, z));
+}
+
 TEST(FluidPressureBackends, SinglePrecisionVCyclesConvergeLikeDoubleOnes) {
     // The float V-cycle inside the double PCG: on odd grids with drops over a pool at density
     // ratio 1000 (and free surfaces), to a relative residual of 1e-10 — far below float's
