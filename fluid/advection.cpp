@@ -57,8 +57,8 @@ public:
                 const Array3<double>& f = *samplers.m_fields[static_cast<std::size_t>(b)];
                 m_data[b] = f.data();
                 m_row[b] = f.index(0, j, k);
-                m_step_a[b] = stride(f, m_axis);
-                m_step_b[b] = stride(f, b);
+                m_step_a[b] = f.stride(m_axis);
+                m_step_b[b] = f.stride(b);
             }
         }
 
@@ -115,15 +115,6 @@ public:
     }
 
 private:
-    /// The flat-index stride of `f` along `axis`.
-    static std::size_t stride(const Array3<double>& f, int axis) {
-        return axis == 0
-                   ? 1
-                   : (axis == 1
-                          ? static_cast<std::size_t>(f.ni())
-                          : static_cast<std::size_t>(f.ni()) * static_cast<std::size_t>(f.nj()));
-    }
-
     std::array<const Array3<double>*, 3> m_fields;
     ClampedVelocity m_velocity;
     double m_inverse_dx;

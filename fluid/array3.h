@@ -45,6 +45,13 @@ public:
                    (static_cast<std::size_t>(j) + static_cast<std::size_t>(m_nj) * k);
     }
 
+    /// The flat-index step along axis 0 (i), 1 (j) or 2 (k): 1, ni or ni·nj.
+    std::size_t stride(int axis) const {
+        return axis == 0 ? 1
+                         : static_cast<std::size_t>(m_ni) *
+                               (axis == 1 ? 1 : static_cast<std::size_t>(m_nj));
+    }
+
     /// True when (i, j, k) is a valid element.
     bool contains(int i, int j, int k) const {
         return i >= 0 && j >= 0 && k >= 0 && i < m_ni && j < m_nj && k < m_nk;

@@ -11,15 +11,27 @@
 
 namespace meniscus::fluid {
 
-/// A coordinate `t` (cells from sample 0) on a lattice axis whose last sample is `last`: clamped
-/// onto [0, last], the lower sample of the pair around it (at most `lower_max`, last − 1 or 0 on
-/// a one-sample axis) and the fraction from it. Branch-free (a vectorisable select).
-inline void split_coordinate(double t, double last, int lower_max, int& lower, double& fraction) {
-    const double s = std::min(std::max(t, 0.0), last);
-    const int truncated = static_cast<int>(s);  // s ≥ 0: truncation floors
-    lower = truncated < lower_max ? truncated : lower_max;
-    fraction = s - lower;
-}
+/// One lattice axis of n samples, sample 0 at `offset` (cells from the grid origin).
+struct LatticeAxis {
+    LatticeAxis() = default;
+    LatticeAxis(int n, double offset_)
+        : offset(offset_), last(n > 1 ? n - 1 : 0), lower_max(n > 1 ? n - 2 : 0) {}
+
+    /// Coordinate `g` (cells) clamped onto the samples: the lower sample of the pair around it
+    /// (0 on a one-sample axis) and the fraction from it. Branch-free (a vectorisable select).
+    void split(double g, int& lower, double& fraction) const {
+        const double s = std::min(std::max(g - offset, 0.0), last);
+        const int truncated = static_cast<int>(s);  // s ≥ 0: truncation floors
+        lower = truncated < lower_max ? truncated : lower_max;
+        fraction = s - lower;
+    }
+    /// More than one sample (an upper sample to blend with).
+    bool spans() const { return last > 0.0; }
+
+    double offset = 0.0;
+    double last = 0.0;  ///< the last sample's index (0 on a one-sample axis)
+    int lower_max = 0;  ///< the largest lower index of a pair (last − 1, or 0)
+};
 
 /// Samples a field whose sample (0, 0, 0) sits at `offset` (cell units, field_offset()), at
 /// points in cell units relative to the grid origin. Points off the lattice are clamped onto it
@@ -29,11 +41,8 @@ class ClampedTrilinear {
 public:
     ClampedTrilinear(const Array3<double>& field, const Eigen::Vector3d& offset)
         : m_data(field.data()),
-          m_axes{
-              Axis(field.ni(), offset.x(), 1),
-              Axis(field.nj(), offset.y(), static_cast<std::size_t>(field.ni())),
-              Axis(field.nk(), offset.z(),
-                   static_cast<std::size_t>(field.ni()) * static_cast<std::size_t>(field.nj()))} {}
+          m_axes{Axis(field, 0, offset.x()), Axis(field, 1, offset.y()),
+                 Axis(field, 2, offset.z())} {}
 
     /// The interpolated value at `g` (cell units).
     double value(const Eigen::Vector3d& g) const {
@@ -72,19 +81,14 @@ public:
     }
 
 private:
-    /// One lattice axis: the offset of sample 0 (cells), the last sample's index and the largest
-    /// lower index of a pair (both 0 on a one-sample axis), the flat-index stride and the step
-    /// from the lower sample to the upper one (0 on a one-sample axis).
+    /// One lattice axis with the flat-index stride and the step from the lower sample to the
+    /// upper one (0 on a one-sample axis).
     struct Axis {
-        Axis(int n, double offset_, std::size_t stride_)
-            : offset(offset_),
-              last(n > 1 ? n - 1 : 0),
-              lower_max(n > 1 ? n - 2 : 0),
-              stride(stride_),
-              step(n > 1 ? stride_ : 0) {}
-        double offset;
-        double last;
-        int lower_max;
+        Axis(const Array3<double>& field, int axis, double offset)
+            : lattice(axis == 0 ? field.ni() : (axis == 1 ? field.nj() : field.nk()), offset),
+              stride(field.stride(axis)),
+              step(lattice.spans() ? stride : 0) {}
+        LatticeAxis lattice;
         std::size_t stride;
         std::size_t step;
     };
@@ -94,7 +98,7 @@ private:
     static void split(const Axis& axis, double g, std::size_t& base, std::size_t& step,
                       double& fraction) {
         int lower;
-        split_coordinate(g - axis.offset, axis.last, axis.lower_max, lower, fraction);
+        axis.lattice.split(g, lower, fraction);
         base = static_cast<std::size_t>(lower) * axis.stride;
         step = axis.step;
     }
@@ -130,14 +134,14 @@ public:
         : m_components{Component(u), Component(v), Component(w)} {
         const int cells[3] = {v.ni(), u.nj(), u.nk()};
         for (int a = 0; a < 3; ++a) {
-            m_face[a] = Lattice(cells[a] + 1, 0.0);
-            m_centre[a] = Lattice(cells[a], 0.5);
+            m_face[a] = LatticeAxis(cells[a] + 1, 0.0);
+            m_centre[a] = LatticeAxis(cells[a], 0.5);
         }
         for (int c = 0; c < 3; ++c)
             for (int a = 0; a < 3; ++a) {
-                const Lattice& l = a == c ? m_face[a] : m_centre[a];
+                const LatticeAxis& l = a == c ? m_face[a] : m_centre[a];
                 Component& m = m_components[c];
-                m.step[a] = l.last > 0.0 ? m.stride[a] : 0;
+                m.step[a] = l.spans() ? m.stride[a] : 0;
             }
     }
 
@@ -159,26 +163,10 @@ public:
     }
 
 private:
-    /// One lattice along one axis: offset of sample 0 (cells), the last sample's index and the
-    /// largest lower index (split_coordinate()).
-    struct Lattice {
-        Lattice() = default;
-        Lattice(int n, double offset_)
-            : offset(offset_), last(n > 1 ? n - 1 : 0), lower_max(n > 1 ? n - 2 : 0) {}
-        void split(double g, int& lower, double& fraction) const {
-            split_coordinate(g - offset, last, lower_max, lower, fraction);
-        }
-        double offset = 0.0;
-        double last = 0.0;
-        int lower_max = 0;
-    };
-
     /// One component's storage, strides and steps to the upper samples.
     struct Component {
         explicit Component(const Array3<double>& f)
-            : data(f.data()),
-              stride{1, static_cast<std::size_t>(f.ni()),
-                     static_cast<std::size_t>(f.ni()) * static_cast<std::size_t>(f.nj())} {}
+            : data(f.data()), stride{f.stride(0), f.stride(1), f.stride(2)} {}
         double value(int i, int j, int k, double fx, double fy, double fz) const {
             const double* p = data + static_cast<std::size_t>(i) +
                               static_cast<std::size_t>(j) * stride[1] +
@@ -194,7 +182,7 @@ private:
     };
 
     Component m_components[3];
-    Lattice m_face[3], m_centre[3];
+    LatticeAxis m_face[3], m_centre[3];
 };
 
 }  // namespace meniscus::fluid
