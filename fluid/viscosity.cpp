@@ -278,9 +278,8 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
     std::vector<double>& fixed = ws.fixed;
     std::vector<double>& b = ws.b;
     // Split u* into the unknowns x (initial guess) and the fixed faces; b = ρ u* − K u_fixed,
-    // K's wall strains relative to moving walls.
-    // In one pass with the split: whether the fixed faces are at rest, and ρ u* on the unknowns
-    // (b when they are).
+    // K's wall strains relative to moving walls. One pass splits, forms ρ u* on the unknowns and
+    // finds whether the fixed faces are at rest.
     op.gather(grid, ws.u_star);
     x.resize(n);
     fixed.resize(n);
@@ -298,10 +297,9 @@ SolveResult ViscositySolver::solve(MacGrid& grid, const InterfaceInput& interfac
             return at_rest;
         },
         [](bool a, bool c) { return a && c; });
-    if (fixed_at_rest && !walls.moving()) {
-        // K 0 = 0 (the map is linear without moving walls): b = ρ u* exactly, without the
-        // operator's three passes (two_phase in a box of walls at rest: every step).
-    } else {
+    // At rest, K 0 = 0 (the map is linear without moving walls): b = ρ u* exactly, without the
+    // operator's three passes (two_phase in a box of walls at rest: every step).
+    if (!fixed_at_rest || walls.moving()) {
         op.stiffness(fixed, b, walls.moving() ? &walls : nullptr);
         for (std::size_t f = 0; f < n; ++f) {
             b[f] = unknown[f] ? density[f] * ws.u_star[f] - b[f] : 0.0;
