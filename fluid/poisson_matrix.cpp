@@ -206,6 +206,15 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
         std::plus<double>());
 }
 
+namespace {
+
+/// The join of the Jacobi-CG passes' reductions.
+ResidualDots add_dots(const ResidualDots& a, const ResidualDots& b) {
+    return ResidualDots{a.rr + b.rr, a.rz + b.rz};
+}
+
+}  // namespace
+
 ResidualDots jacobi_cg_update(double alpha, const std::vector<double>& p,
                               const std::vector<double>& q, const std::vector<double>& d,
                               std::vector<double>& x, std::vector<double>& r,
@@ -228,9 +237,7 @@ ResidualDots jacobi_cg_update(double alpha, const std::vector<double>& p,
             }
             return sums;
         },
-        [](const ResidualDots& a, const ResidualDots& b) {
-            return ResidualDots{a.rr + b.rr, a.rz + b.rz};
-        });
+        add_dots);
 }
 
 ResidualDots jacobi_cg_start(const std::vector<double>& b, const std::vector<double>& q,
@@ -257,9 +264,7 @@ ResidualDots jacobi_cg_start(const std::vector<double>& b, const std::vector<dou
             }
             return sums;
         },
-        [](const ResidualDots& a, const ResidualDots& c) {
-            return ResidualDots{a.rr + c.rr, a.rz + c.rz};
-        });
+        add_dots);
 }
 
 void axpy(double alpha, const std::vector<double>& x, std::vector<double>& y) {
