@@ -61,7 +61,7 @@ const char* USAGE =
     "        Started by mpirun -n K, a fluid scene's grid is split over K ranks (rank 0\n"
     "        writes); its checkpoints resume on any number of ranks, or without mpirun.\n"
     "  validate [--quick|--full] [--out DIR] [--case A1|A2|A3|A4|A6|B1|...|B7]...\n"
-    "           [--xi X]... [--curvature-operator cotangent|quartic_fit]...\n"
+    "           [--xi X]... [--curvature-operator cotangent|quartic_fit]... [--threads N]\n"
     "        run the validation cases — A: the paper's geometric flows (A1–A4; A5 is the cost\n"
     "        of A1's steps) and Zalesak's notched sphere turned once (A6), B: two-phase flow with\n"
     "        surface tension (quick: coarse, minutes; full: the references' resolutions, hours)\n"
@@ -70,7 +70,8 @@ const char* USAGE =
     "        --xi runs only the part-A runs at edge length X m (repeatable, e.g.\n"
     "        --full --case A2 --xi 0.01); --curvature-operator runs A2 only with the named\n"
     "        operators (repeatable; naming quartic_fit runs its dumbbell rows in quick mode\n"
-    "        too); exit code 1 if a run failed or intersected\n"
+    "        too); --threads N (or MENISCUS_THREADS) limits the worker threads; exit code 1\n"
+    "        if a run failed or intersected\n"
     "  scene-reference\n"
     "        print every scene key with its type, default, unit and meaning (Markdown)\n"
     "\n"
@@ -243,6 +244,7 @@ int dispatch(int argc, char** argv) {
         return command_run({args.begin() + 1, args.end()});
     if (command == "validate") {
         ValidateOptions options;
+        int threads = 0;
         for (size_t i = 1; i < args.size(); ++i) {
             if (args[i] == "--quick")
                 options.full = false;
@@ -256,6 +258,8 @@ int dispatch(int argc, char** argv) {
                 options.xis.push_back(parse_positive_length("--xi", args[++i]));
             else if (args[i] == "--curvature-operator" && i + 1 < args.size())
                 options.curvature_operators.push_back(args[++i]);  // checked below
+            else if (args[i] == "--threads" && i + 1 < args.size())
+                threads = parse_positive_int("--threads", args[++i]);
             else
                 throw UsageError("validate: unknown or incomplete option " + args[i]);
         }
@@ -264,6 +268,7 @@ int dispatch(int argc, char** argv) {
         } catch (const std::invalid_argument& e) {
             throw UsageError(e.what());
         }
+        const auto thread_limit = thread_control(threads);
         return run_validation(options);
     }
     if (command == "scene-reference") {

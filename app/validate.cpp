@@ -20,6 +20,7 @@
 #include "tracker/mesh_measures.h"
 
 #include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <chrono>
@@ -668,6 +669,11 @@ int run_validation(const ValidateOptions& options) {
     results["all_ok"] = c.all_ok;
     results["failures"] = c.failures;
     results["wall_seconds"] = seconds_since(wall_start);
+    // The worker threads the runs could use (--threads, MENISCUS_THREADS or every core), which
+    // the timings above depend on.
+    const auto threads =
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+    results["threads"] = threads;
     {
         std::ofstream f(out / "results.json");
         if (!f)
@@ -680,8 +686,8 @@ int run_validation(const ValidateOptions& options) {
        << (c.all_ok ? "all runs finished, no intersections with safety on" : "FAILURES") << "**";
     for (const std::string& f : c.failures)
         md << "\n- " << f;
-    md << "\n\nWall time: " << format_number(seconds_since(wall_start), "%.0f") << " s. "
-       << plot_note << "\n\n"
+    md << "\n\nWall time: " << format_number(seconds_since(wall_start), "%.0f") << " s on "
+       << threads << (threads == 1 ? " thread. " : " threads. ") << plot_note << "\n\n"
        << body.str();
     std::ofstream f(out / "report.md");
     if (!f)

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -130,6 +131,31 @@ TEST_F(CliTest, ValidateBadXiValueIsBadInput) {
         EXPECT_EQ(o.exit_code, 2) << value;
         EXPECT_NE(o.output.find("--xi: expected a positive length"), std::string::npos) << value;
     }
+}
+
+TEST_F(CliTest, ValidateThreadsLimitTheWorkerThreadsAndAreRecorded) {
+    // validate used to ignore MENISCUS_THREADS and had no --threads: its timings then came from
+    // every core whatever the user asked. results.json records the limit the runs had.
+    const auto threads_recorded = [&](const std::string& args) {
+        const fs::path out = m_dir / "v";
+        fs::remove_all(out);
+        const Outcome o =
+            run_meniscus("validate --quick --case A6 --xi 0.04 --out " + out.string() + " " + args);
+        EXPECT_EQ(o.exit_code, 0) << o.output;
+        std::ifstream f(out / "results.json");
+        const std::string text((std::istreambuf_iterator<char>(f)),
+                               std::istreambuf_iterator<char>());
+        const std::size_t at = text.find("\"threads\": ");
+        return at == std::string::npos ? -1 : std::stoi(text.substr(at + 11));
+    };
+    EXPECT_EQ(threads_recorded("--threads 1"), 1);
+    ::setenv("MENISCUS_THREADS", "1", 1);
+    EXPECT_EQ(threads_recorded(""), 1);
+    ::unsetenv("MENISCUS_THREADS");
+    const Outcome zero = run_meniscus("validate --case A6 --threads 0 --out " + m_dir.string());
+    EXPECT_EQ(zero.exit_code, 2);
+    EXPECT_NE(zero.output.find("--threads: expected a whole number"), std::string::npos)
+        << zero.output;
 }
 
 TEST_F(CliTest, MissingSceneFileNamesTheFile) {
