@@ -295,7 +295,9 @@ TEST(DistributedRun, CheckpointsResumeOnAnyNumberOfRanks) {
 TEST(DistributedRun, JetPinchPinchesAtTheSameFrame) {
     // The shortened jet of tests/coupling/test_scenes_physics.cpp (JetPinchQuick): one
     // wavelength, periodic along x (the grid is split along z, across the column), 27 cells per
-    // wavelength, a 15 % perturbation: it pinches after about 12 ms.
+    // wavelength, a 15 % perturbation: it pinches after about 12 ms. On 2 ranks only (48 s
+    // alone; with 3 ranks too it took 172 s in the suite): a topology change on 3 ranks is
+    // BubbleMergeMergesAtTheSameFrame's, the middle rank's two seams StaticDropOnThreeRanks'.
     Json scene = with_hypre(shipped_scene("jet_pinch"));
     Json& column = scene["surface"]["shape"];
     const double wavelength = column["wavelength"];
@@ -307,7 +309,7 @@ TEST(DistributedRun, JetPinchPinchesAtTheSameFrame) {
     column["amplitude"] = 0.15;
     scene["time"] = {{"end", 0.014}, {"frames", 14}};
     scene["output"] = {{"ply", true}, {"vdb", false}};
-    expect_same_runs("jet_pinch", scene, {2, 3}, 2);
+    expect_same_run("jet_pinch", scene, 2, 2);
 }
 
 TEST(DistributedRun, RefusesWhatIsNotDistributedYet) {

@@ -386,13 +386,14 @@ TEST(FlowScenes, SphereUnderMeanCurvatureRecordsTheExactRadius) {
     fs::remove_all(options.out_dir);
 }
 
-/// Signed vertex distances to the exact sphere of the last frame of the A2 sphere scene at
-/// ξ = 0.02 run to t_end, with tangent-plane smoothing or smoothing along a cubic fitted over
+/// Signed vertex distances to the exact sphere of the last frame of the A2 sphere scene at edge
+/// length ξ run to t_end, with tangent-plane smoothing or smoothing along a cubic fitted over
 /// each two-ring where it turns by at most 0.6 rad, and collapses to the butterfly point or to
 /// the fitted surface.
-tracker::SurfaceError shrunk_sphere_error(double t_end, bool fitted_smoothing,
+tracker::SurfaceError shrunk_sphere_error(double xi, double t_end, bool fitted_smoothing,
                                           bool fitted_collapses) {
     Scene scene = load_scene(FLOW_SCENES + "a2_sphere_xi0.02.json");
+    scene.surface.edge_length = xi;
     scene.tracker.verify_intersection_free = false;
     scene.tracker.remesh.smoothing_onto_fitted_surface = fitted_smoothing;
     scene.tracker.remesh.smoothing_fit_degree = 3;
@@ -413,26 +414,31 @@ tracker::SurfaceError shrunk_sphere_error(double t_end, bool fitted_smoothing,
 }
 
 TEST(FlowScenes, ShrinkingSphereStaysOnItsRadiusWithFittedSmoothingAndCollapses) {
-    // Issue #5: R = 0.3 → 0.1 at ξ = 0.02, a mesh collapsing from 14 800 to 1 900 triangles.
-    // Tangent-plane smoothing of the irregular rings the collapses leave sinks every vertex
-    // inside the exact sphere (the A2 dumbbell's drops at ξ = 0.01 likewise, by 2.3e-5, above
-    // the paper's error): the quadric's area-weighted normal leans towards the larger triangles,
-    // which is where the vertex moves, so its tangent plane dips into the surface. Smoothing
-    // along a cubic fitted over each two-ring does not (the drops' two-rings turn by about 0.4
-    // here, under the bound), and with collapses onto the fitted surface too every vertex stays
-    // within a few micrometres. Measured mean signed vertex error: tangent plane −8.66e-5,
-    // fitted smoothing −6.6e-6, both fitted +3.1e-6 (all vertices in [+2.3e-6, +4.4e-6]).
-    const double plane = shrunk_sphere_error(0.02, false, false).vertex_mean_signed;
-    const double fitted = shrunk_sphere_error(0.02, true, false).vertex_mean_signed;
-    const tracker::SurfaceError both = shrunk_sphere_error(0.02, true, true);
-    std::cout << "[ measured ] A2 sphere 0.3 → 0.1, ξ = 0.02: mean signed vertex error, tangent "
+    // Issue #5: R = 0.3 → 0.1, a mesh collapsing to an eighth of its triangles. Tangent-plane
+    // smoothing of the irregular rings the collapses leave sinks every vertex inside the exact
+    // sphere (the A2 dumbbell's drops at ξ = 0.01 likewise, by 2.3e-5, above the paper's error):
+    // the quadric's area-weighted normal leans towards the larger triangles, which is where the
+    // vertex moves, so its tangent plane dips into the surface. Smoothing along a cubic fitted
+    // over each two-ring does not (the drops' two-rings turn by about 0.4, under the bound), and
+    // with collapses onto the fitted surface too every vertex stays close to the sphere.
+    // Measured mean signed vertex error at ξ = 0.03 (36 s for the three runs): tangent plane
+    // −1.88e-4, fitted smoothing −1.30e-5, both fitted +1.52e-5 (max |error| 2.38e-5). At
+    // ξ = 0.02 (169 s in the suite, so no longer run here): −8.66e-5, −6.6e-6, +3.1e-6 (all
+    // vertices in [+2.3e-6, +4.4e-6]); at ξ = 0.04 the both-fitted max is 0.20 of the tangent
+    // plane's mean, too close to tell apart.
+    constexpr double XI = 0.03;
+    const double plane = shrunk_sphere_error(XI, 0.02, false, false).vertex_mean_signed;
+    const double fitted = shrunk_sphere_error(XI, 0.02, true, false).vertex_mean_signed;
+    const tracker::SurfaceError both = shrunk_sphere_error(XI, 0.02, true, true);
+    std::cout << "[ measured ] A2 sphere 0.3 → 0.1, ξ = " << XI
+              << ": mean signed vertex error, tangent "
               << "plane " << plane << ", fitted smoothing " << fitted << ", fitted smoothing and "
               << "collapses " << both.vertex_mean_signed << " (max |error| " << both.vertex_linf
               << ")\n";
-    EXPECT_LT(plane, -5e-5);
+    EXPECT_LT(plane, -1e-4);
     EXPECT_LT(std::abs(fitted), 0.25 * std::abs(plane));
-    EXPECT_LT(both.vertex_linf, 1e-5);
-    EXPECT_LT(both.vertex_linf, std::abs(plane) / 10.0);
+    EXPECT_LT(both.vertex_linf, 5e-5);
+    EXPECT_LT(both.vertex_linf, std::abs(plane) / 4.0);
 }
 
 TEST(FlowScenes, OpenSheetKeepsItsBoundaryUnderCurlNoise) {
