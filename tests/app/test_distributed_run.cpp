@@ -137,7 +137,7 @@ void expect_same_as_alone(const std::string& name, const Json& scene, const fs::
         EXPECT_NEAR(sa[f]["kinetic_energy"].get<double>(), sb[f]["kinetic_energy"].get<double>(),
                     1e-6 * sa[f]["kinetic_energy"].get<double>() + 1e-30)
             << name << ", frame " << f;
-        char ply[32];
+        char ply[40];  // "surface_" + up to 20 digits + ".ply"
         std::snprintf(ply, sizeof ply, "surface_%04zu.ply", f);
         const meniscus::tracker::MeshData ma = meniscus::tracker::read_ply((alone / ply).string());
         const meniscus::tracker::MeshData mb = meniscus::tracker::read_ply((split / ply).string());
