@@ -4,12 +4,12 @@
 
 #include "app/validate.h"
 #include "app/validate_parameters.h"
+#include "tests/one_worker_thread.h"
 #include "tracker/implicit_mesher.h"
 #include "tracker/implicit_shape.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
-#include <tbb/global_control.h>
 
 #include <unistd.h>
 
@@ -125,6 +125,11 @@ constexpr double B7_DT_CHANGE_RELATIVE = 0.02;
 /// Steady by the end: the last quarter's mean speed against the quarter before.
 constexpr double B7_STEADY_RELATIVE = 0.01;
 
+// The validation runs on one worker thread (validate --quick alone: 201 s wall and 336 s of CPU
+// on 2 threads, 257 s and 291 s on 1; results.json the same but for its timings).
+::testing::Environment* const ONE_WORKER_THREAD =
+    ::testing::AddGlobalTestEnvironment(new meniscus::testing::OneWorkerThread);
+
 class QuickValidation : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
@@ -135,10 +140,6 @@ protected:
         ValidateOptions options;
         options.out_dir = s_out.string();
         options.quiet = true;
-        // One worker thread: ctest runs two tests at once on 2 cores, and two threads each only
-        // share them (alone, 2026-12-08: 201 s wall and 336 s CPU on 2 threads, 257 s and 291 s
-        // on 1). results.json is the same at any thread count but for its timings.
-        const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
         s_exit_code = run_validation(options);
         std::ifstream f(s_out / "results.json");
         s_results = Json::parse(f);

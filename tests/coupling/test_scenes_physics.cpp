@@ -12,13 +12,13 @@
 #include "app/fluid_measures.h"
 #include "app/fluid_references.h"
 #include "app/scene_setup.h"
+#include "tests/one_worker_thread.h"
 #include "tracker/mesh_io.h"
 #include "tracker/mesh_measures.h"
 #include "tracker/topology/separate.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
-#include <tbb/global_control.h>
 
 #include <unistd.h>
 
@@ -28,7 +28,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -37,25 +36,11 @@ namespace meniscus::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// This program's scene runs (here and in test_periodic_scenes.cpp) on one worker thread: ctest
-/// runs two tests at once on 2 cores, where two threads each only share them and cost more CPU
-/// (jet_nozzle, 40 steps: 37.8 s of CPU on 1 thread, 42.7 s on 2). The frames do not depend on
-/// the thread count (Resume.OneAndTwoThreadsWriteTheSameFrames).
-class OneWorkerThread : public testing::Environment {
-public:
-    void SetUp() override {
-        m_limit = std::make_unique<tbb::global_control>(
-            tbb::global_control::max_allowed_parallelism, 1);
-    }
-    void TearDown() override { m_limit.reset(); }
-
-private:
-    std::unique_ptr<tbb::global_control> m_limit;
-};
-testing::Environment* const ONE_WORKER_THREAD =
-    testing::AddGlobalTestEnvironment(new OneWorkerThread);
 using Json = nlohmann::json;
+
+// This program's scene runs (here and in test_periodic_scenes.cpp) on one worker thread.
+::testing::Environment* const ONE_WORKER_THREAD =
+    ::testing::AddGlobalTestEnvironment(new meniscus::testing::OneWorkerThread);
 
 /// docs/validation.md B5: volume of each phase within 0.5 % over a run with volume correction on.
 constexpr double PHASE_VOLUME_TOLERANCE = 0.005;
