@@ -1,5 +1,6 @@
 // Runs the built `meniscus` binary and checks exit codes and messages of each error path.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <fcntl.h>
 #include <sys/wait.h>
@@ -143,10 +144,7 @@ TEST_F(CliTest, ValidateThreadsLimitTheWorkerThreadsAndAreRecorded) {
             run_meniscus("validate --quick --case A6 --xi 0.04 --out " + out.string() + " " + args);
         EXPECT_EQ(o.exit_code, 0) << o.output;
         std::ifstream f(out / "results.json");
-        const std::string text((std::istreambuf_iterator<char>(f)),
-                               std::istreambuf_iterator<char>());
-        const std::size_t at = text.find("\"threads\": ");
-        return at == std::string::npos ? -1 : std::stoi(text.substr(at + 11));
+        return nlohmann::json::parse(f).value("threads", -1);
     };
     EXPECT_EQ(threads_recorded("--threads 1"), 1);
     ::setenv("MENISCUS_THREADS", "1", 1);
